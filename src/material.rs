@@ -1,0 +1,283 @@
+//! Material constants: transversely isotropic piezoelectric ceramics (poled along z) and
+//! isotropic elastic solids, with built-in presets and validation.
+//!
+//! # Conventions
+//! Plane strain in the x–z plane, z into the half-plane (along the poling axis), SI units.
+//! The constitutive law (stiffness at constant field `c^E`, permittivity at constant strain `ε^S`,
+//! electric field `E = −∇φ`) is
+//!
+//! ```text
+//! σxx = c11 ∂x ux + c13 ∂z uz + e31 ∂z φ      Dx = e15 (∂z ux + ∂x uz) − ε11 ∂x φ
+//! σzz = c13 ∂x ux + c33 ∂z uz + e33 ∂z φ      Dz = e31 ∂x ux + e33 ∂z uz − ε33 ∂z φ
+//! σxz = c44 (∂z ux + ∂x uz) + e15 ∂x φ
+//! ```
+//!
+//! Only the in-plane constants enter a plane problem, so `c12`/`c66` are not needed.
+//!
+//! # Validity
+//! A material is accepted when every constant is finite, the in-plane elastic matrix
+//! `[[c11, c13], [c13, c33]]` and `c44` are positive definite, and `ε11, ε33 > 0`; an isotropic
+//! solid needs `μ > 0` (or `E > 0`) and `−1 < ν ≤ 1/2` (`ν = 1/2`, the incompressible limit,
+//! is allowed: it is the uncoupled case of Dundurs' β = 0 used for the Cattaneo–Mindlin checks).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::Issue;
+
+/// Constants of a transversely isotropic piezoelectric solid poled along z (SI units).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PiezoConstants {
+    /// Elastic stiffness c11 (Pa).
+    pub c11: f64,
+    /// Elastic stiffness c13 (Pa).
+    pub c13: f64,
+    /// Elastic stiffness c33 (Pa).
+    pub c33: f64,
+    /// Elastic stiffness c44 (Pa).
+    pub c44: f64,
+    /// Piezoelectric constant e31 (C/m²).
+    pub e31: f64,
+    /// Piezoelectric constant e33 (C/m²).
+    pub e33: f64,
+    /// Piezoelectric constant e15 (C/m²).
+    pub e15: f64,
+    /// Permittivity ε11 (C/(V·m)).
+    pub eps11: f64,
+    /// Permittivity ε33 (C/(V·m)).
+    pub eps33: f64,
+}
+
+/// Constants of an isotropic elastic solid.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IsotropicConstants {
+    /// Shear modulus μ (Pa).
+    pub shear_modulus: f64,
+    /// Poisson's ratio ν (–).
+    pub poisson_ratio: f64,
+}
+
+impl IsotropicConstants {
+    /// From Young's modulus `E` (Pa) and Poisson's ratio `ν`.
+    pub fn from_youngs(youngs_modulus: f64, poisson_ratio: f64) -> Self {
+        Self { shear_modulus: youngs_modulus / (2.0 * (1.0 + poisson_ratio)), poisson_ratio }
+    }
+
+    /// Young's modulus `E = 2μ(1 + ν)` (Pa).
+    pub fn youngs_modulus(&self) -> f64 {
+        2.0 * self.shear_modulus * (1.0 + self.poisson_ratio)
+    }
+
+    /// Plane-strain modulus `E* = E/(1 − ν²)` of the half-plane against a rigid punch (Pa).
+    pub fn plane_strain_modulus(&self) -> f64 {
+        self.youngs_modulus() / (1.0 - self.poisson_ratio * self.poisson_ratio)
+    }
+
+    /// Dundurs' second constant for a rigid punch on this solid: `β = (1 − 2ν)/(2(1 − ν))`.
+    pub fn dundurs_beta(&self) -> f64 {
+        (1.0 - 2.0 * self.poisson_ratio) / (2.0 * (1.0 - self.poisson_ratio))
+    }
+}
+
+/// A half-plane material.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Material {
+    /// Transversely isotropic piezoelectric ceramic, poled along z.
+    Piezoelectric(PiezoConstants),
+    /// Isotropic elastic solid (no electric coupling).
+    Elastic(IsotropicConstants),
+}
+
+/// A built-in material with its source.
+#[derive(Debug, Clone, Copy)]
+pub struct Preset {
+    /// Name used in scenarios (lower case).
+    pub name: &'static str,
+    /// Where the constants come from.
+    pub source: &'static str,
+    /// The constants.
+    pub material: Material,
+}
+
+/// PZT-4, the seed paper's Table 1 (after Ke et al. 2008).
+pub const PZT4: PiezoConstants = PiezoConstants {
+    c11: 139e9,
+    c13: 74.3e9,
+    c33: 115e9,
+    c44: 25.6e9,
+    e31: -5.2,
+    e33: 15.1,
+    e15: 12.7,
+    eps11: 64.61e-10,
+    eps33: 56.2e-10,
+};
+
+/// Aluminium as used in the seed paper's Figure 4 check (μ = 27.3 GPa, ν = 0.3).
+pub const ALUMINIUM: IsotropicConstants =
+    IsotropicConstants { shear_modulus: 27.3e9, poisson_ratio: 0.3 };
+
+/// The built-in presets.
+pub fn presets() -> Vec<Preset> {
+    vec![
+        Preset {
+            name: "pzt4",
+            source: "PZT-4, seed paper Table 1 (Ke et al. 2008)",
+            material: Material::Piezoelectric(PZT4),
+        },
+        Preset {
+            name: "aluminium",
+            source: "aluminium, seed paper Section 6 (Nowell, Hills & Sackfield 1988 check)",
+            material: Material::Elastic(ALUMINIUM),
+        },
+    ]
+}
+
+/// Look a preset up by name (case-insensitive; `-` and `_` ignored).
+pub fn preset(name: &str) -> Option<Preset> {
+    let key = normalise_name(name);
+    presets().into_iter().find(|p| normalise_name(p.name) == key)
+}
+
+fn normalise_name(name: &str) -> String {
+    name.chars().filter(|c| *c != '-' && *c != '_').flat_map(char::to_lowercase).collect()
+}
+
+impl Material {
+    /// Every problem with the constants, each naming the constant (`path` is prefixed).
+    pub fn validate(&self, path: &str) -> Vec<Issue> {
+        let mut issues = Vec::new();
+        match self {
+            Material::Piezoelectric(c) => {
+                let named = [
+                    ("c11", c.c11, "Pa"),
+                    ("c13", c.c13, "Pa"),
+                    ("c33", c.c33, "Pa"),
+                    ("c44", c.c44, "Pa"),
+                    ("e31", c.e31, "C/m²"),
+                    ("e33", c.e33, "C/m²"),
+                    ("e15", c.e15, "C/m²"),
+                    ("eps11", c.eps11, "C/(V·m)"),
+                    ("eps33", c.eps33, "C/(V·m)"),
+                ];
+                for (name, value, unit) in named {
+                    if !value.is_finite() {
+                        issues.push(Issue::new(
+                            format!("{path}.{name}"),
+                            format!("{value} {unit} is invalid; it must be finite"),
+                        ));
+                    }
+                }
+                if !issues.is_empty() {
+                    return issues;
+                }
+                for (name, value, unit) in [("c11", c.c11, "Pa"), ("c33", c.c33, "Pa"), ("c44", c.c44, "Pa")] {
+                    if value <= 0.0 {
+                        issues.push(Issue::new(
+                            format!("{path}.{name}"),
+                            format!("{value:e} {unit} is invalid; it must be > 0 (elastic stiffness positive definite)"),
+                        ));
+                    }
+                }
+                if c.c11 > 0.0 && c.c33 > 0.0 && c.c11 * c.c33 - c.c13 * c.c13 <= 0.0 {
+                    issues.push(Issue::new(
+                        format!("{path}.c13"),
+                        format!(
+                            "{:e} Pa is invalid; it must satisfy c13² < c11·c33 = {:e} Pa² (elastic stiffness positive definite)",
+                            c.c13,
+                            c.c11 * c.c33
+                        ),
+                    ));
+                }
+                for (name, value) in [("eps11", c.eps11), ("eps33", c.eps33)] {
+                    if value <= 0.0 {
+                        issues.push(Issue::new(
+                            format!("{path}.{name}"),
+                            format!("{value:e} C/(V·m) is invalid; it must be > 0 (permittivity positive definite)"),
+                        ));
+                    }
+                }
+            }
+            Material::Elastic(c) => {
+                if !(c.shear_modulus.is_finite() && c.shear_modulus > 0.0) {
+                    issues.push(Issue::new(
+                        format!("{path}.shear_modulus"),
+                        format!("{:e} Pa is invalid; it must be finite and > 0", c.shear_modulus),
+                    ));
+                }
+                if !(c.poisson_ratio.is_finite() && c.poisson_ratio > -1.0 && c.poisson_ratio <= 0.5) {
+                    issues.push(Issue::new(
+                        format!("{path}.poisson_ratio"),
+                        format!("{} is invalid; it must lie in (−1, 0.5]", c.poisson_ratio),
+                    ));
+                }
+            }
+        }
+        issues
+    }
+
+    /// Scale the piezoelectric coupling constants by `factor` (used to study the uncoupled limit).
+    pub fn with_scaled_coupling(&self, factor: f64) -> Material {
+        match *self {
+            Material::Piezoelectric(c) => Material::Piezoelectric(PiezoConstants {
+                e31: c.e31 * factor,
+                e33: c.e33 * factor,
+                e15: c.e15 * factor,
+                ..c
+            }),
+            m @ Material::Elastic(_) => m,
+        }
+    }
+
+    /// Whether the material carries electric fields.
+    pub fn is_piezoelectric(&self) -> bool {
+        matches!(self, Material::Piezoelectric(_))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_are_valid_and_found_by_name() {
+        for p in presets() {
+            assert!(p.material.validate("material").is_empty(), "{}", p.name);
+        }
+        assert!(preset("PZT-4").is_some());
+        assert!(preset("Aluminium").is_some());
+        assert!(preset("unobtainium").is_none());
+    }
+
+    #[test]
+    fn validation_names_each_bad_constant() {
+        let bad = Material::Piezoelectric(PiezoConstants { c44: -1.0, eps33: 0.0, ..PZT4 });
+        let issues = bad.validate("material.constants");
+        let paths: Vec<_> = issues.iter().map(|i| i.path.as_str()).collect();
+        assert_eq!(paths, ["material.constants.c44", "material.constants.eps33"]);
+        assert!(issues[0].message.contains("must be > 0"));
+
+        let not_pd = Material::Piezoelectric(PiezoConstants { c13: 200e9, ..PZT4 });
+        let issues = not_pd.validate("m");
+        assert_eq!(issues.len(), 1);
+        assert_eq!(issues[0].path, "m.c13");
+        assert!(issues[0].message.contains("c13² < c11·c33"));
+
+        let nan = Material::Piezoelectric(PiezoConstants { e33: f64::NAN, ..PZT4 });
+        assert_eq!(nan.validate("m")[0].path, "m.e33");
+
+        let iso = Material::Elastic(IsotropicConstants { shear_modulus: 0.0, poisson_ratio: 0.7 });
+        let paths: Vec<_> = iso.validate("m").into_iter().map(|i| i.path).collect();
+        assert_eq!(paths, ["m.shear_modulus", "m.poisson_ratio"]);
+    }
+
+    #[test]
+    fn isotropic_relations() {
+        let al = ALUMINIUM;
+        approx::assert_relative_eq!(al.youngs_modulus(), 70.98e9, max_relative = 1e-12);
+        approx::assert_relative_eq!(al.dundurs_beta(), 0.4 / 1.4, max_relative = 1e-12);
+        let back = IsotropicConstants::from_youngs(al.youngs_modulus(), 0.3);
+        approx::assert_relative_eq!(back.shear_modulus, al.shear_modulus, max_relative = 1e-12);
+    }
+}

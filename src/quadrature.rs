@@ -1,0 +1,464 @@
+//! Gauss–Chebyshev collocation for Cauchy singular integral equations (Erdogan & Gupta 1972),
+//! Chebyshev transforms, and closed-form Cauchy transforms of the Chebyshev representations.
+//!
+//! Everything here lives on the normalised interval [−1, 1] and depends only on the number of
+//! nodes M, so a [`BoundedGrid`] or [`UnboundedGrid`] is built and LU-factored once per run
+//! (faer) and reused by every solve. Geometry enters through the affine map to the physical
+//! interval, which leaves `(1/π)⨍ f(θ)/(θ − τ) dθ` unchanged.
+//!
+//! # Bounded at both ends (seed eqs. 36–38, 56, 58)
+//! `f(θ) = √(1 − θ²) ψ(θ)`, `ψ = Σ_{n=1}^{M} β_n U_{n−1}`. Nodes `θ_l = cos(lπ/(M+1))`,
+//! `l = 1..M` (zeros of U_M); collocation `τ_r = cos((2r−1)π/(2(M+1)))`, `r = 1..M+1`
+//! (zeros of T_{M+1}):
+//!
+//! ```text
+//! (1/π)⨍ √(1−t²) U_{n−1}(t)/(t − τ) dt = −T_n(τ)              (|τ| < 1)
+//!                                      = −z^n, z = τ − sgn(τ)√(τ²−1)   (|τ| > 1)
+//! Σ_l (1−θ_l²) ψ_l /((M+1)(θ_l − τ_r)) = h(τ_r),   r = 1..M+1
+//! ```
+//!
+//! The M+1 equations in M unknowns are consistent only if the discrete Chebyshev mean
+//! `h̄ = Σ_r h(τ_r)/(M+1)` vanishes (the columns of the matrix sum to zero because
+//! `Σ_r 1/(θ_l − τ_r) = T'_{M+1}(θ_l)/T_{M+1}(θ_l) = 0`). We solve the square system
+//! `[A | 1](ψ; λ) = h`, which returns `λ = h̄`: the consistency residual that fixes a free
+//! geometric parameter (seed eq. 35).
+//!
+//! # Unbounded at both ends (seed eqs. 41–42)
+//! `f(θ) = ϑ(θ)/√(1 − θ²)`, `ϑ = Σ_{n=0}^{M−1} γ_n T_n`. Nodes `θ_l = cos((2l−1)π/(2M))`
+//! (zeros of T_M); collocation `τ_r = cos(rπ/M)`, `r = 1..M−1` (zeros of U_{M−1}), plus the
+//! resultant `∫ f dθ = πγ_0 = (π/M) Σ_l ϑ_l`:
+//!
+//! ```text
+//! (1/π)⨍ T_n(t)/(√(1−t²)(t − τ)) dt = U_{n−1}(τ)  (n ≥ 1),  0  (n = 0)      (|τ| < 1)
+//!                                   = −sgn(τ) z^n / √(τ²−1)                 (|τ| > 1)
+//! ```
+
+use faer::Mat;
+use faer::linalg::solvers::{PartialPivLu, Solve};
+use std::f64::consts::PI;
+
+/// Grid and factored collocation matrix for densities bounded at both ends.
+#[derive(Debug, Clone)]
+pub struct BoundedGrid {
+    m: usize,
+    /// Nodes θ_l = cos(lπ/(M+1)), l = 1..M.
+    pub nodes: Vec<f64>,
+    /// Collocation points τ_r = cos((2r−1)π/(2(M+1))), r = 1..M+1.
+    pub collocation: Vec<f64>,
+    /// `sin(t_l) sin(n t_l)` table for the U-coefficient transform, row n−1.
+    transform: Vec<f64>,
+    lu: PartialPivLu<f64>,
+}
+
+/// Grid and factored collocation matrix for densities unbounded (inverse square root) at both ends.
+#[derive(Debug, Clone)]
+pub struct UnboundedGrid {
+    m: usize,
+    /// Nodes θ_l = cos((2l−1)π/(2M)), l = 1..M.
+    pub nodes: Vec<f64>,
+    /// Collocation points τ_r = cos(rπ/M), r = 1..M−1.
+    pub collocation: Vec<f64>,
+    /// `T_n(θ_l)` table, row n.
+    transform: Vec<f64>,
+    lu: PartialPivLu<f64>,
+}
+
+impl BoundedGrid {
+    /// Build and factor for `m ≥ 2` nodes.
+    pub fn new(m: usize) -> Self {
+        assert!(m >= 2, "at least two collocation nodes");
+        let nodes: Vec<f64> = (1..=m).map(|l| (l as f64 * PI / (m as f64 + 1.0)).cos()).collect();
+        let collocation: Vec<f64> =
+            (1..=m + 1).map(|r| ((2 * r - 1) as f64 * PI / (2.0 * (m as f64 + 1.0))).cos()).collect();
+        let a = Mat::<f64>::from_fn(m + 1, m + 1, |r, l| {
+            if l == m {
+                1.0
+            } else {
+                (1.0 - nodes[l] * nodes[l]) / ((m as f64 + 1.0) * (nodes[l] - collocation[r]))
+            }
+        });
+        let lu = a.partial_piv_lu();
+        let mut transform = vec![0.0; m * m];
+        for n in 1..=m {
+            for l in 1..=m {
+                let t = l as f64 * PI / (m as f64 + 1.0);
+                transform[(n - 1) * m + (l - 1)] = 2.0 / (m as f64 + 1.0) * t.sin() * (n as f64 * t).sin();
+            }
+        }
+        Self { m, nodes, collocation, transform, lu }
+    }
+
+    /// Number of nodes M.
+    pub fn len(&self) -> usize {
+        self.m
+    }
+
+    /// Always false (M ≥ 2).
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Solve `(1/π)⨍ √(1−θ²)ψ(θ)/(θ − τ) dθ = h(τ)` from `h` at the M+1 collocation points.
+    /// Writes ψ at the nodes into `psi` and returns the consistency residual `h̄`.
+    pub fn solve(&self, rhs: &[f64], psi: &mut [f64]) -> f64 {
+        debug_assert_eq!(rhs.len(), self.m + 1);
+        let mut x = rhs.to_vec();
+        self.lu.solve_in_place(faer::ColMut::from_slice_mut(&mut x));
+        psi.copy_from_slice(&x[..self.m]);
+        x[self.m]
+    }
+
+    /// `∫_{−1}^{1} √(1−θ²) ψ dθ = π/(M+1) Σ (1−θ_l²) ψ_l` (seed eq. 38).
+    pub fn integral(&self, psi: &[f64]) -> f64 {
+        let s: f64 = self.nodes.iter().zip(psi).map(|(t, p)| (1.0 - t * t) * p).sum();
+        PI / (self.m as f64 + 1.0) * s
+    }
+
+    /// Coefficients β_n, n = 1..M, of `ψ = Σ β_n U_{n−1}` from nodal values (index n−1).
+    pub fn coefficients(&self, psi: &[f64], beta: &mut [f64]) {
+        for (n, b) in beta.iter_mut().enumerate() {
+            let row = &self.transform[n * self.m..(n + 1) * self.m];
+            *b = row.iter().zip(psi).map(|(a, p)| a * p).sum();
+        }
+    }
+}
+
+impl UnboundedGrid {
+    /// Build and factor for `m ≥ 2` nodes.
+    pub fn new(m: usize) -> Self {
+        assert!(m >= 2, "at least two collocation nodes");
+        let nodes: Vec<f64> = (1..=m).map(|l| ((2 * l - 1) as f64 * PI / (2.0 * m as f64)).cos()).collect();
+        let collocation: Vec<f64> = (1..m).map(|r| (r as f64 * PI / m as f64).cos()).collect();
+        let a = Mat::<f64>::from_fn(m, m, |r, l| {
+            if r == m - 1 { PI / m as f64 } else { 1.0 / (m as f64 * (nodes[l] - collocation[r])) }
+        });
+        let lu = a.partial_piv_lu();
+        let mut transform = vec![0.0; m * m];
+        for n in 0..m {
+            for l in 0..m {
+                let scale = if n == 0 { 1.0 } else { 2.0 } / m as f64;
+                transform[n * m + l] = scale * (n as f64 * nodes[l].acos()).cos();
+            }
+        }
+        Self { m, nodes, collocation, transform, lu }
+    }
+
+    /// Number of nodes M.
+    pub fn len(&self) -> usize {
+        self.m
+    }
+
+    /// Always false (M ≥ 2).
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Solve `(1/π)⨍ ϑ(θ)/(√(1−θ²)(θ − τ)) dθ = h(τ_r)` (M−1 values) with
+    /// `∫ ϑ/√(1−θ²) dθ = resultant`; writes ϑ at the nodes.
+    pub fn solve(&self, rhs: &[f64], resultant: f64, theta: &mut [f64]) {
+        debug_assert_eq!(rhs.len(), self.m - 1);
+        theta[..self.m - 1].copy_from_slice(rhs);
+        theta[self.m - 1] = resultant;
+        self.lu.solve_in_place(faer::ColMut::from_slice_mut(theta));
+    }
+
+    /// Coefficients γ_n, n = 0..M−1, of `ϑ = Σ γ_n T_n` from nodal values.
+    pub fn coefficients(&self, theta: &[f64], gamma: &mut [f64]) {
+        for (n, g) in gamma.iter_mut().enumerate() {
+            let row = &self.transform[n * self.m..(n + 1) * self.m];
+            *g = row.iter().zip(theta).map(|(a, p)| a * p).sum();
+        }
+    }
+}
+
+/// A density bounded at both ends of [−1, 1], `f = √(1−θ²) Σ β_n U_{n−1}(θ)`.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BoundedSeries {
+    /// β_1 … β_M.
+    pub beta: Vec<f64>,
+}
+
+/// A density with inverse-square-root ends, `f = Σ γ_n T_n(θ)/√(1−θ²)`.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct UnboundedSeries {
+    /// γ_0 … γ_{M−1}.
+    pub gamma: Vec<f64>,
+}
+
+/// Σ c_k T_k(x) by Clenshaw's recurrence (c_0 included).
+pub fn chebyshev_t_sum(c: &[f64], x: f64) -> f64 {
+    let (mut b1, mut b2) = (0.0, 0.0);
+    for &ck in c.iter().skip(1).rev() {
+        let b0 = 2.0 * x * b1 - b2 + ck;
+        b2 = b1;
+        b1 = b0;
+    }
+    c.first().copied().unwrap_or(0.0) + x * b1 - b2
+}
+
+/// Σ c_k U_k(x) by Clenshaw's recurrence.
+pub fn chebyshev_u_sum(c: &[f64], x: f64) -> f64 {
+    let (mut b1, mut b2) = (0.0, 0.0);
+    for &ck in c.iter().rev() {
+        let b0 = 2.0 * x * b1 - b2 + ck;
+        b2 = b1;
+        b1 = b0;
+    }
+    b1
+}
+
+/// Σ c_n z^n, n from `start`, by Horner.
+fn power_sum(c: &[f64], z: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, &cn| acc * z + cn)
+}
+
+/// `z = τ − sgn(τ)√(τ²−1)` for |τ| ≥ 1, the exterior Joukowski variable (|z| ≤ 1).
+fn exterior(tau: f64) -> f64 {
+    tau - tau.signum() * (tau * tau - 1.0).max(0.0).sqrt()
+}
+
+impl BoundedSeries {
+    /// From nodal ψ values on a grid.
+    pub fn from_nodes(grid: &BoundedGrid, psi: &[f64]) -> Self {
+        let mut beta = vec![0.0; grid.len()];
+        grid.coefficients(psi, &mut beta);
+        Self { beta }
+    }
+
+    /// ψ(τ) for |τ| ≤ 1 (polynomial; may be evaluated at the ends).
+    pub fn psi(&self, tau: f64) -> f64 {
+        chebyshev_u_sum(&self.beta, tau)
+    }
+
+    /// The density `√(1−τ²) ψ(τ)`, zero outside [−1, 1].
+    pub fn density(&self, tau: f64) -> f64 {
+        if tau.abs() >= 1.0 { 0.0 } else { (1.0 - tau * tau).sqrt() * self.psi(tau) }
+    }
+
+    /// `∫_{−1}^{1} density = π β_1/2`.
+    pub fn integral(&self) -> f64 {
+        PI * self.beta.first().copied().unwrap_or(0.0) / 2.0
+    }
+
+    /// `(1/π)⨍ f(t)/(t − τ) dt` at any τ (inside: −Σ β_n T_n; outside: −Σ β_n zⁿ).
+    pub fn cauchy(&self, tau: f64) -> f64 {
+        if tau.abs() < 1.0 {
+            // −Σ_{n≥1} β_n T_n(τ)
+            let mut c = Vec::with_capacity(self.beta.len() + 1);
+            c.push(0.0);
+            c.extend(self.beta.iter().map(|b| -b));
+            chebyshev_t_sum(&c, tau)
+        } else {
+            let z = exterior(tau);
+            -z * power_sum(&self.beta, z)
+        }
+    }
+}
+
+impl UnboundedSeries {
+    /// From nodal ϑ values on a grid.
+    pub fn from_nodes(grid: &UnboundedGrid, theta: &[f64]) -> Self {
+        let mut gamma = vec![0.0; grid.len()];
+        grid.coefficients(theta, &mut gamma);
+        Self { gamma }
+    }
+
+    /// ϑ(τ) (polynomial).
+    pub fn theta(&self, tau: f64) -> f64 {
+        chebyshev_t_sum(&self.gamma, tau)
+    }
+
+    /// The density `ϑ(τ)/√(1−τ²)`, zero outside (−1, 1), infinite at the ends.
+    pub fn density(&self, tau: f64) -> f64 {
+        if tau.abs() >= 1.0 { 0.0 } else { self.theta(tau) / (1.0 - tau * tau).sqrt() }
+    }
+
+    /// `∫ density = π γ_0`.
+    pub fn integral(&self) -> f64 {
+        PI * self.gamma.first().copied().unwrap_or(0.0)
+    }
+
+    /// `(1/π)⨍ f(t)/(t − τ) dt` at any τ ≠ ±1 (inside: Σ γ_n U_{n−1}; outside: −sgn z^n/√(τ²−1)).
+    pub fn cauchy(&self, tau: f64) -> f64 {
+        if tau.abs() < 1.0 {
+            if self.gamma.len() < 2 {
+                return 0.0;
+            }
+            chebyshev_u_sum(&self.gamma[1..], tau)
+        } else {
+            let z = exterior(tau);
+            -tau.signum() * power_sum(&self.gamma, z) / (tau * tau - 1.0).sqrt()
+        }
+    }
+}
+
+/// Gauss–Legendre nodes and weights on [−1, 1] (Newton on Legendre polynomials).
+pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut x = vec![0.0; n];
+    let mut w = vec![0.0; n];
+    for i in 0..n {
+        let mut z = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 0.0;
+        for _ in 0..100 {
+            let (mut p0, mut p1) = (1.0, z);
+            for k in 2..=n {
+                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
+                p0 = p1;
+                p1 = p2;
+            }
+            if n == 1 {
+                p0 = 1.0;
+                p1 = z;
+            }
+            dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
+            let dz = p1 / dp;
+            z -= dz;
+            if dz.abs() < 1e-16 {
+                break;
+            }
+        }
+        x[i] = z;
+        w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
+    }
+    (x, w)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn t(n: usize, x: f64) -> f64 {
+        let mut c = vec![0.0; n + 1];
+        c[n] = 1.0;
+        chebyshev_t_sum(&c, x)
+    }
+    fn u(n: usize, x: f64) -> f64 {
+        let mut c = vec![0.0; n + 1];
+        c[n] = 1.0;
+        chebyshev_u_sum(&c, x)
+    }
+
+    #[test]
+    fn clenshaw_matches_trigonometric_definitions() {
+        for &x in &[-0.93, -0.2, 0.0, 0.41, 0.999] {
+            let th: f64 = f64::acos(x);
+            for n in 0..12 {
+                assert!((t(n, x) - (n as f64 * th).cos()).abs() < 1e-13);
+                assert!((u(n, x) - ((n + 1) as f64 * th).sin() / th.sin()).abs() < 1e-11);
+            }
+        }
+    }
+
+    /// (1/π)⨍ √(1−t²) U_{n−1}(t)/(t−x) dt = −T_n(x), discretely, at the collocation points.
+    #[test]
+    fn bounded_quadrature_reproduces_minus_t_n() {
+        let m = 24;
+        let g = BoundedGrid::new(m);
+        for n in 1..m {
+            for &x in &g.collocation {
+                let s: f64 = g
+                    .nodes
+                    .iter()
+                    .map(|&th| (1.0 - th * th) * u(n - 1, th) / ((m as f64 + 1.0) * (th - x)))
+                    .sum();
+                assert!((s + t(n, x)).abs() < 1e-12, "n = {n}, x = {x}: {s} vs {}", -t(n, x));
+            }
+        }
+    }
+
+    /// (1/π)⨍ T_n(t)/(√(1−t²)(t−x)) dt = U_{n−1}(x), discretely, at the collocation points.
+    #[test]
+    fn unbounded_quadrature_reproduces_u_n_minus_1() {
+        let m = 24;
+        let g = UnboundedGrid::new(m);
+        for n in 0..m {
+            for &x in &g.collocation {
+                let s: f64 = g.nodes.iter().map(|&th| t(n, th) / (m as f64 * (th - x))).sum();
+                let expected = if n == 0 { 0.0 } else { u(n - 1, x) };
+                assert!((s - expected).abs() < 1e-11, "n = {n}, x = {x}");
+            }
+        }
+    }
+
+    #[test]
+    fn bounded_solve_inverts_and_reports_consistency() {
+        let m = 20;
+        let g = BoundedGrid::new(m);
+        // h = −T_3 − 0.5 T_1 + 0.25 ⇒ ψ = U_2 + 0.5 U_0, consistency residual 0.25.
+        let rhs: Vec<f64> = g.collocation.iter().map(|&x| -t(3, x) - 0.5 * t(1, x) + 0.25).collect();
+        let mut psi = vec![0.0; m];
+        let lambda = g.solve(&rhs, &mut psi);
+        assert!((lambda - 0.25).abs() < 1e-13);
+        for (th, p) in g.nodes.iter().zip(&psi) {
+            assert!((p - (u(2, *th) + 0.5)).abs() < 1e-12);
+        }
+        let series = BoundedSeries::from_nodes(&g, &psi);
+        assert!((series.beta[0] - 0.5).abs() < 1e-13 && (series.beta[2] - 1.0).abs() < 1e-13);
+        assert!((g.integral(&psi) - series.integral()).abs() < 1e-13);
+        assert!((series.integral() - PI / 4.0).abs() < 1e-13);
+        // Cauchy transform inside and outside, against direct formulas for ψ = 1 (β_1 = 1).
+        let one = BoundedSeries { beta: vec![1.0] };
+        for &x in &[-0.7, 0.3] {
+            assert!((one.cauchy(x) + x).abs() < 1e-15);
+        }
+        for &x in &[-3.0f64, 1.5] {
+            let exact = -x + x.signum() * (x * x - 1.0).sqrt();
+            assert!((one.cauchy(x) - exact).abs() < 1e-14);
+        }
+        assert!((series.psi(1.0) - (3.0 + 0.5)).abs() < 1e-12, "U_2(1) = 3");
+    }
+
+    #[test]
+    fn unbounded_solve_inverts() {
+        let m = 16;
+        let g = UnboundedGrid::new(m);
+        // ϑ = 2 + T_2 − 0.5 T_5 ⇒ h = U_1 − 0.5 U_4, resultant 2π.
+        let rhs: Vec<f64> = g.collocation.iter().map(|&x| u(1, x) - 0.5 * u(4, x)).collect();
+        let mut th = vec![0.0; m];
+        g.solve(&rhs, 2.0 * PI, &mut th);
+        let series = UnboundedSeries::from_nodes(&g, &th);
+        let expected = [2.0, 0.0, 1.0, 0.0, 0.0, -0.5];
+        for (n, e) in expected.iter().enumerate() {
+            assert!((series.gamma[n] - e).abs() < 1e-12, "γ_{n}");
+        }
+        assert!((series.integral() - 2.0 * PI).abs() < 1e-12);
+        // Outside Cauchy transform of 1/√(1−t²): −sgn(x)/√(x²−1).
+        let one = UnboundedSeries { gamma: vec![1.0] };
+        assert!((one.cauchy(2.0) + 1.0 / 3f64.sqrt()).abs() < 1e-15);
+        assert!((one.cauchy(-2.0) - 1.0 / 3f64.sqrt()).abs() < 1e-15);
+        // T_1: 1 − |x|/√(x²−1).
+        let t1 = UnboundedSeries { gamma: vec![0.0, 1.0] };
+        assert!((t1.cauchy(1.25) - (1.0 - 1.25 / (1.25f64 * 1.25 - 1.0).sqrt())).abs() < 1e-14);
+    }
+
+    #[test]
+    fn exterior_cauchy_matches_brute_force_quadrature() {
+        // f = √(1−t²)(U_0 + 0.3 U_3), direct Gauss–Chebyshev of high order at x = 1.3.
+        let s = BoundedSeries { beta: vec![1.0, 0.0, 0.0, 0.3] };
+        let x = 1.3;
+        let n = 400;
+        let direct: f64 = (1..=n)
+            .map(|l| {
+                let th = (l as f64 * PI / (n as f64 + 1.0)).cos();
+                (1.0 - th * th) * s.psi(th) / ((n as f64 + 1.0) * (th - x))
+            })
+            .sum();
+        assert!((direct - s.cauchy(x)).abs() < 1e-12);
+        let w = UnboundedSeries { gamma: vec![0.5, 0.2, -0.1] };
+        let direct: f64 = (1..=n)
+            .map(|l| {
+                let th = ((2 * l - 1) as f64 * PI / (2.0 * n as f64)).cos();
+                w.theta(th) / (n as f64 * (th - x))
+            })
+            .sum();
+        assert!((direct - w.cauchy(x)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials() {
+        let (x, w) = gauss_legendre(12);
+        let s: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(10)).sum();
+        assert!((s - 2.0 / 11.0).abs() < 1e-14);
+        assert!((w.iter().sum::<f64>() - 2.0).abs() < 1e-14);
+    }
+}
