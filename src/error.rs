@@ -17,7 +17,10 @@ pub struct Issue {
 impl Issue {
     /// A new issue at `path`.
     pub fn new(path: impl Into<String>, message: impl Into<String>) -> Self {
-        Self { path: path.into(), message: message.into() }
+        Self {
+            path: path.into(),
+            message: message.into(),
+        }
     }
 }
 
@@ -28,7 +31,11 @@ impl fmt::Display for Issue {
 }
 
 fn list(issues: &[Issue]) -> String {
-    issues.iter().map(|i| format!("  - {i}")).collect::<Vec<_>>().join("\n")
+    issues
+        .iter()
+        .map(|i| format!("  - {i}"))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// Why a solve failed. Carried inside [`Error::Solve`] with the step context.

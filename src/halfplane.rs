@@ -141,7 +141,11 @@ impl SurfaceCompliance {
 
     /// The same coefficients in the seed paper's convention (Appendix A.2).
     pub fn paper_coefficients(&self) -> PaperCoefficients {
-        let e = self.electric.unwrap_or(ElectricCompliance { y23: 0.0, y33: 0.0, w13: 0.0 });
+        let e = self.electric.unwrap_or(ElectricCompliance {
+            y23: 0.0,
+            y33: 0.0,
+            w13: 0.0,
+        });
         // −i f = X  ⇔  f = i X (purely imaginary entries).
         let imag = |x: f64| (0.0, x);
         let real = |x: f64| (x, 0.0);
@@ -189,7 +193,9 @@ struct Scales {
 
 /// `Y = i A B⁻¹` for the decaying modes of the Stroh matrix built from (Q, R, T).
 fn surface_admittance(q: &Matrix3<f64>, r: &Matrix3<f64>, t: &Matrix3<f64>) -> Matrix3<C64> {
-    let t_inv = t.try_inverse().expect("T block of a valid material is invertible");
+    let t_inv = t
+        .try_inverse()
+        .expect("T block of a valid material is invertible");
     let n1 = -t_inv * r.transpose();
     let n3 = r * t_inv * r.transpose() - q;
     let n4 = -r * t_inv;
@@ -201,7 +207,9 @@ fn surface_admittance(q: &Matrix3<f64>, r: &Matrix3<f64>, t: &Matrix3<f64>) -> M
     // Matrix sign of Z = −iN: eigenvalue −ip has real part Im p.
     let mut s: Matrix6<C64> = n.map(|v| C64::new(0.0, -v));
     for _ in 0..100 {
-        let inv = s.try_inverse().expect("Stroh matrix has no real eigenvalue");
+        let inv = s
+            .try_inverse()
+            .expect("Stroh matrix has no real eigenvalue");
         // Determinant scaling accelerates the first iterations.
         let mu = s.determinant().norm().powf(-1.0 / 6.0);
         let next = (s * C64::new(mu, 0.0) + inv * C64::new(1.0 / mu, 0.0)) * C64::new(0.5, 0.0);
@@ -301,7 +309,11 @@ impl SurfaceFieldCoefficients {
                 + c.c11 * c.c33 * c.eps33
                 - 2.0 * c.c13 * c.e31 * c.e33)
                 / den,
-            delta4: if material.is_piezoelectric() { c.e15 * c.e15 / c.c44 + c.eps11 } else { 0.0 },
+            delta4: if material.is_piezoelectric() {
+                c.e15 * c.e15 / c.c44 + c.eps11
+            } else {
+                0.0
+            },
             e15_over_c44: c.e15 / c.c44,
         }
     }
@@ -322,7 +334,9 @@ mod tests {
 
     #[test]
     fn pzt4_matches_appendix_a2_except_the_f22_typo() {
-        let f = SurfaceCompliance::of(&Material::Piezoelectric(PZT4)).paper_coefficients().f;
+        let f = SurfaceCompliance::of(&Material::Piezoelectric(PZT4))
+            .paper_coefficients()
+            .f;
         for i in 0..3 {
             for j in 0..3 {
                 let (re, im) = f[i][j];
@@ -336,7 +350,12 @@ mod tests {
                     assert_relative_eq!(value, 7.5241e-12, max_relative = 5e-5);
                 } else {
                     // A.2 gives 5 significant digits; 5e−5 is half a unit in the last one.
-                    assert!(rel < 5e-5, "f{}{}: computed {value:e}, A.2 {printed:e}", i + 1, j + 1);
+                    assert!(
+                        rel < 5e-5,
+                        "f{}{}: computed {value:e}, A.2 {printed:e}",
+                        i + 1,
+                        j + 1
+                    );
                 }
             }
         }
@@ -346,14 +365,22 @@ mod tests {
     fn admittance_is_hermitian_reciprocity() {
         for scale in [1.0, 0.3, 1e-3] {
             let m = Material::Piezoelectric(PZT4).with_scaled_coupling(scale);
-            let Material::Piezoelectric(c) = m else { unreachable!() };
+            let Material::Piezoelectric(c) = m else {
+                unreachable!()
+            };
             let y = admittance_matrix(&c);
             for i in 0..3 {
                 for j in 0..3 {
                     let (a, b) = (y[i][j], y[j][i]);
                     let size = (y[i][i].0.abs() * y[j][j].0.abs()).sqrt();
-                    assert!((a.0 - b.0).abs() < 1e-12 * size, "Re Y not symmetric at {i}{j}");
-                    assert!((a.1 + b.1).abs() < 1e-12 * size, "Im Y not antisymmetric at {i}{j}");
+                    assert!(
+                        (a.0 - b.0).abs() < 1e-12 * size,
+                        "Re Y not symmetric at {i}{j}"
+                    );
+                    assert!(
+                        (a.1 + b.1).abs() < 1e-12 * size,
+                        "Im Y not antisymmetric at {i}{j}"
+                    );
                 }
             }
             // Mirror symmetry: no Cauchy x–(z, φ) coupling, no local z–φ coupling.
@@ -367,7 +394,10 @@ mod tests {
     fn stroh_reproduces_johnson_for_an_isotropic_solid() {
         // Isotropic stiffness with e = 0: triple root p = i, the case that breaks A.1.
         for nu in [0.0, 0.3, 0.45] {
-            let iso = IsotropicConstants { shear_modulus: 27.3e9, poisson_ratio: nu };
+            let iso = IsotropicConstants {
+                shear_modulus: 27.3e9,
+                poisson_ratio: nu,
+            };
             let mu = iso.shear_modulus;
             let lambda = 2.0 * mu * nu / (1.0 - 2.0 * nu);
             let c = PiezoConstants {
@@ -385,7 +415,12 @@ mod tests {
             let exact = isotropic(&iso);
             assert_relative_eq!(stroh.y11, exact.y11, max_relative = 1e-10);
             assert_relative_eq!(stroh.y22, exact.y22, max_relative = 1e-10);
-            assert_relative_eq!(stroh.w12, exact.w12, max_relative = 1e-10, epsilon = 1e-10 * exact.y11);
+            assert_relative_eq!(
+                stroh.w12,
+                exact.w12,
+                max_relative = 1e-10,
+                epsilon = 1e-10 * exact.y11
+            );
             // Electric part decoupled: y33 = −1/ε, no coupling.
             let e = stroh.electric.unwrap();
             assert_relative_eq!(e.y33, -1.0 / 1e-8, max_relative = 1e-10);
@@ -400,14 +435,26 @@ mod tests {
 
     #[test]
     fn vanishing_coupling_tends_continuously_to_the_elastic_result() {
-        let elastic = piezoelectric(&PiezoConstants { e31: 0.0, e33: 0.0, e15: 0.0, ..PZT4 });
+        let elastic = piezoelectric(&PiezoConstants {
+            e31: 0.0,
+            e33: 0.0,
+            e15: 0.0,
+            ..PZT4
+        });
         let mut previous = f64::INFINITY;
         for scale in [1e-1, 1e-2, 1e-3] {
-            let s = SurfaceCompliance::of(&Material::Piezoelectric(PZT4).with_scaled_coupling(scale));
-            let gap = (s.y11 - elastic.y11).abs().max((s.y22 - elastic.y22).abs()).max((s.w12 - elastic.w12).abs())
+            let s =
+                SurfaceCompliance::of(&Material::Piezoelectric(PZT4).with_scaled_coupling(scale));
+            let gap = (s.y11 - elastic.y11)
+                .abs()
+                .max((s.y22 - elastic.y22).abs())
+                .max((s.w12 - elastic.w12).abs())
                 / elastic.y11;
             // Coefficients are even in the coupling: the gap falls like scale².
-            assert!(gap < previous / 50.0 || gap < 1e-12, "gap {gap} at scale {scale}");
+            assert!(
+                gap < previous / 50.0 || gap < 1e-12,
+                "gap {gap} at scale {scale}"
+            );
             previous = gap;
         }
         assert!(previous < 1e-6);

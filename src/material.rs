@@ -61,7 +61,10 @@ pub struct IsotropicConstants {
 impl IsotropicConstants {
     /// From Young's modulus `E` (Pa) and Poisson's ratio `ν`.
     pub fn from_youngs(youngs_modulus: f64, poisson_ratio: f64) -> Self {
-        Self { shear_modulus: youngs_modulus / (2.0 * (1.0 + poisson_ratio)), poisson_ratio }
+        Self {
+            shear_modulus: youngs_modulus / (2.0 * (1.0 + poisson_ratio)),
+            poisson_ratio,
+        }
     }
 
     /// Young's modulus `E = 2μ(1 + ν)` (Pa).
@@ -115,16 +118,56 @@ pub const PZT4: PiezoConstants = PiezoConstants {
 };
 
 /// Aluminium as used in the seed paper's Figure 4 check (μ = 27.3 GPa, ν = 0.3).
-pub const ALUMINIUM: IsotropicConstants =
-    IsotropicConstants { shear_modulus: 27.3e9, poisson_ratio: 0.3 };
+pub const ALUMINIUM: IsotropicConstants = IsotropicConstants {
+    shear_modulus: 27.3e9,
+    poisson_ratio: 0.3,
+};
+
+/// PZT-5H: Berlincourt, Curran & Jaffe (1964), in Mason (ed.) *Physical Acoustics* I-A, as
+/// tabulated (c^E, e, ε^S) by Auld, *Acoustic Fields and Waves in Solids* I (1973), Appendix 2.
+pub const PZT5H: PiezoConstants = PiezoConstants {
+    c11: 126e9,
+    c13: 84.1e9,
+    c33: 117e9,
+    c44: 23.0e9,
+    e31: -6.5,
+    e33: 23.3,
+    e15: 17.0,
+    eps11: 1.505e-8,
+    eps33: 1.302e-8,
+};
+
+/// BaTiO3 ceramic: Berlincourt, Curran & Jaffe (1964), same tabulation as [`PZT5H`]
+/// (c44 = 43.9 GPa from s44^E; ε^S = 1115 ε0, 1260 ε0).
+pub const BATIO3: PiezoConstants = PiezoConstants {
+    c11: 150e9,
+    c13: 66e9,
+    c33: 146e9,
+    c44: 43.9e9,
+    e31: -4.35,
+    e33: 17.5,
+    e15: 11.4,
+    eps11: 9.87e-9,
+    eps33: 1.116e-8,
+};
 
 /// The built-in presets.
 pub fn presets() -> Vec<Preset> {
     vec![
         Preset {
             name: "pzt4",
-            source: "PZT-4, seed paper Table 1 (Ke et al. 2008)",
+            source: "PZT-4, seed paper Table 1 (Ke et al. 2008; Berlincourt et al. 1964 c^E, e, ε^S)",
             material: Material::Piezoelectric(PZT4),
+        },
+        Preset {
+            name: "pzt5h",
+            source: "PZT-5H, Berlincourt, Curran & Jaffe 1964, as tabulated by Auld 1973 (Vol. I, App. 2)",
+            material: Material::Piezoelectric(PZT5H),
+        },
+        Preset {
+            name: "batio3",
+            source: "BaTiO3 ceramic, Berlincourt, Curran & Jaffe 1964, as tabulated by Auld 1973 (Vol. I, App. 2)",
+            material: Material::Piezoelectric(BATIO3),
         },
         Preset {
             name: "aluminium",
@@ -137,11 +180,16 @@ pub fn presets() -> Vec<Preset> {
 /// Look a preset up by name (case-insensitive; `-` and `_` ignored).
 pub fn preset(name: &str) -> Option<Preset> {
     let key = normalise_name(name);
-    presets().into_iter().find(|p| normalise_name(p.name) == key)
+    presets()
+        .into_iter()
+        .find(|p| normalise_name(p.name) == key)
 }
 
 fn normalise_name(name: &str) -> String {
-    name.chars().filter(|c| *c != '-' && *c != '_').flat_map(char::to_lowercase).collect()
+    name.chars()
+        .filter(|c| *c != '-' && *c != '_')
+        .flat_map(char::to_lowercase)
+        .collect()
 }
 
 impl Material {
@@ -172,7 +220,11 @@ impl Material {
                 if !issues.is_empty() {
                     return issues;
                 }
-                for (name, value, unit) in [("c11", c.c11, "Pa"), ("c33", c.c33, "Pa"), ("c44", c.c44, "Pa")] {
+                for (name, value, unit) in [
+                    ("c11", c.c11, "Pa"),
+                    ("c33", c.c33, "Pa"),
+                    ("c44", c.c44, "Pa"),
+                ] {
                     if value <= 0.0 {
                         issues.push(Issue::new(
                             format!("{path}.{name}"),
@@ -203,10 +255,16 @@ impl Material {
                 if !(c.shear_modulus.is_finite() && c.shear_modulus > 0.0) {
                     issues.push(Issue::new(
                         format!("{path}.shear_modulus"),
-                        format!("{:e} Pa is invalid; it must be finite and > 0", c.shear_modulus),
+                        format!(
+                            "{:e} Pa is invalid; it must be finite and > 0",
+                            c.shear_modulus
+                        ),
                     ));
                 }
-                if !(c.poisson_ratio.is_finite() && c.poisson_ratio > -1.0 && c.poisson_ratio <= 0.5) {
+                if !(c.poisson_ratio.is_finite()
+                    && c.poisson_ratio > -1.0
+                    && c.poisson_ratio <= 0.5)
+                {
                     issues.push(Issue::new(
                         format!("{path}.poisson_ratio"),
                         format!("{} is invalid; it must lie in (−1, 0.5]", c.poisson_ratio),
@@ -252,10 +310,17 @@ mod tests {
 
     #[test]
     fn validation_names_each_bad_constant() {
-        let bad = Material::Piezoelectric(PiezoConstants { c44: -1.0, eps33: 0.0, ..PZT4 });
+        let bad = Material::Piezoelectric(PiezoConstants {
+            c44: -1.0,
+            eps33: 0.0,
+            ..PZT4
+        });
         let issues = bad.validate("material.constants");
         let paths: Vec<_> = issues.iter().map(|i| i.path.as_str()).collect();
-        assert_eq!(paths, ["material.constants.c44", "material.constants.eps33"]);
+        assert_eq!(
+            paths,
+            ["material.constants.c44", "material.constants.eps33"]
+        );
         assert!(issues[0].message.contains("must be > 0"));
 
         let not_pd = Material::Piezoelectric(PiezoConstants { c13: 200e9, ..PZT4 });
@@ -264,10 +329,16 @@ mod tests {
         assert_eq!(issues[0].path, "m.c13");
         assert!(issues[0].message.contains("c13² < c11·c33"));
 
-        let nan = Material::Piezoelectric(PiezoConstants { e33: f64::NAN, ..PZT4 });
+        let nan = Material::Piezoelectric(PiezoConstants {
+            e33: f64::NAN,
+            ..PZT4
+        });
         assert_eq!(nan.validate("m")[0].path, "m.e33");
 
-        let iso = Material::Elastic(IsotropicConstants { shear_modulus: 0.0, poisson_ratio: 0.7 });
+        let iso = Material::Elastic(IsotropicConstants {
+            shear_modulus: 0.0,
+            poisson_ratio: 0.7,
+        });
         let paths: Vec<_> = iso.validate("m").into_iter().map(|i| i.path).collect();
         assert_eq!(paths, ["m.shear_modulus", "m.poisson_ratio"]);
     }

@@ -67,9 +67,12 @@ impl BoundedGrid {
     /// Build and factor for `m ≥ 2` nodes.
     pub fn new(m: usize) -> Self {
         assert!(m >= 2, "at least two collocation nodes");
-        let nodes: Vec<f64> = (1..=m).map(|l| (l as f64 * PI / (m as f64 + 1.0)).cos()).collect();
-        let collocation: Vec<f64> =
-            (1..=m + 1).map(|r| ((2 * r - 1) as f64 * PI / (2.0 * (m as f64 + 1.0))).cos()).collect();
+        let nodes: Vec<f64> = (1..=m)
+            .map(|l| (l as f64 * PI / (m as f64 + 1.0)).cos())
+            .collect();
+        let collocation: Vec<f64> = (1..=m + 1)
+            .map(|r| ((2 * r - 1) as f64 * PI / (2.0 * (m as f64 + 1.0))).cos())
+            .collect();
         let a = Mat::<f64>::from_fn(m + 1, m + 1, |r, l| {
             if l == m {
                 1.0
@@ -82,10 +85,17 @@ impl BoundedGrid {
         for n in 1..=m {
             for l in 1..=m {
                 let t = l as f64 * PI / (m as f64 + 1.0);
-                transform[(n - 1) * m + (l - 1)] = 2.0 / (m as f64 + 1.0) * t.sin() * (n as f64 * t).sin();
+                transform[(n - 1) * m + (l - 1)] =
+                    2.0 / (m as f64 + 1.0) * t.sin() * (n as f64 * t).sin();
             }
         }
-        Self { m, nodes, collocation, transform, lu }
+        Self {
+            m,
+            nodes,
+            collocation,
+            transform,
+            lu,
+        }
     }
 
     /// Number of nodes M.
@@ -110,7 +120,12 @@ impl BoundedGrid {
 
     /// `∫_{−1}^{1} √(1−θ²) ψ dθ = π/(M+1) Σ (1−θ_l²) ψ_l` (seed eq. 38).
     pub fn integral(&self, psi: &[f64]) -> f64 {
-        let s: f64 = self.nodes.iter().zip(psi).map(|(t, p)| (1.0 - t * t) * p).sum();
+        let s: f64 = self
+            .nodes
+            .iter()
+            .zip(psi)
+            .map(|(t, p)| (1.0 - t * t) * p)
+            .sum();
         PI / (self.m as f64 + 1.0) * s
     }
 
@@ -127,10 +142,16 @@ impl UnboundedGrid {
     /// Build and factor for `m ≥ 2` nodes.
     pub fn new(m: usize) -> Self {
         assert!(m >= 2, "at least two collocation nodes");
-        let nodes: Vec<f64> = (1..=m).map(|l| ((2 * l - 1) as f64 * PI / (2.0 * m as f64)).cos()).collect();
+        let nodes: Vec<f64> = (1..=m)
+            .map(|l| ((2 * l - 1) as f64 * PI / (2.0 * m as f64)).cos())
+            .collect();
         let collocation: Vec<f64> = (1..m).map(|r| (r as f64 * PI / m as f64).cos()).collect();
         let a = Mat::<f64>::from_fn(m, m, |r, l| {
-            if r == m - 1 { PI / m as f64 } else { 1.0 / (m as f64 * (nodes[l] - collocation[r])) }
+            if r == m - 1 {
+                PI / m as f64
+            } else {
+                1.0 / (m as f64 * (nodes[l] - collocation[r]))
+            }
         });
         let lu = a.partial_piv_lu();
         let mut transform = vec![0.0; m * m];
@@ -140,7 +161,13 @@ impl UnboundedGrid {
                 transform[n * m + l] = scale * (n as f64 * nodes[l].acos()).cos();
             }
         }
-        Self { m, nodes, collocation, transform, lu }
+        Self {
+            m,
+            nodes,
+            collocation,
+            transform,
+            lu,
+        }
     }
 
     /// Number of nodes M.
@@ -232,7 +259,11 @@ impl BoundedSeries {
 
     /// The density `√(1−τ²) ψ(τ)`, zero outside [−1, 1].
     pub fn density(&self, tau: f64) -> f64 {
-        if tau.abs() >= 1.0 { 0.0 } else { (1.0 - tau * tau).sqrt() * self.psi(tau) }
+        if tau.abs() >= 1.0 {
+            0.0
+        } else {
+            (1.0 - tau * tau).sqrt() * self.psi(tau)
+        }
     }
 
     /// `∫_{−1}^{1} density = π β_1/2`.
@@ -270,7 +301,11 @@ impl UnboundedSeries {
 
     /// The density `ϑ(τ)/√(1−τ²)`, zero outside (−1, 1), infinite at the ends.
     pub fn density(&self, tau: f64) -> f64 {
-        if tau.abs() >= 1.0 { 0.0 } else { self.theta(tau) / (1.0 - tau * tau).sqrt() }
+        if tau.abs() >= 1.0 {
+            0.0
+        } else {
+            self.theta(tau) / (1.0 - tau * tau).sqrt()
+        }
     }
 
     /// `∫ density = π γ_0`.
@@ -361,7 +396,11 @@ mod tests {
                     .iter()
                     .map(|&th| (1.0 - th * th) * u(n - 1, th) / ((m as f64 + 1.0) * (th - x)))
                     .sum();
-                assert!((s + t(n, x)).abs() < 1e-12, "n = {n}, x = {x}: {s} vs {}", -t(n, x));
+                assert!(
+                    (s + t(n, x)).abs() < 1e-12,
+                    "n = {n}, x = {x}: {s} vs {}",
+                    -t(n, x)
+                );
             }
         }
     }
@@ -373,7 +412,11 @@ mod tests {
         let g = UnboundedGrid::new(m);
         for n in 0..m {
             for &x in &g.collocation {
-                let s: f64 = g.nodes.iter().map(|&th| t(n, th) / (m as f64 * (th - x))).sum();
+                let s: f64 = g
+                    .nodes
+                    .iter()
+                    .map(|&th| t(n, th) / (m as f64 * (th - x)))
+                    .sum();
                 let expected = if n == 0 { 0.0 } else { u(n - 1, x) };
                 assert!((s - expected).abs() < 1e-11, "n = {n}, x = {x}");
             }
@@ -385,7 +428,11 @@ mod tests {
         let m = 20;
         let g = BoundedGrid::new(m);
         // h = −T_3 − 0.5 T_1 + 0.25 ⇒ ψ = U_2 + 0.5 U_0, consistency residual 0.25.
-        let rhs: Vec<f64> = g.collocation.iter().map(|&x| -t(3, x) - 0.5 * t(1, x) + 0.25).collect();
+        let rhs: Vec<f64> = g
+            .collocation
+            .iter()
+            .map(|&x| -t(3, x) - 0.5 * t(1, x) + 0.25)
+            .collect();
         let mut psi = vec![0.0; m];
         let lambda = g.solve(&rhs, &mut psi);
         assert!((lambda - 0.25).abs() < 1e-13);
@@ -413,7 +460,11 @@ mod tests {
         let m = 16;
         let g = UnboundedGrid::new(m);
         // ϑ = 2 + T_2 − 0.5 T_5 ⇒ h = U_1 − 0.5 U_4, resultant 2π.
-        let rhs: Vec<f64> = g.collocation.iter().map(|&x| u(1, x) - 0.5 * u(4, x)).collect();
+        let rhs: Vec<f64> = g
+            .collocation
+            .iter()
+            .map(|&x| u(1, x) - 0.5 * u(4, x))
+            .collect();
         let mut th = vec![0.0; m];
         g.solve(&rhs, 2.0 * PI, &mut th);
         let series = UnboundedSeries::from_nodes(&g, &th);
@@ -427,14 +478,18 @@ mod tests {
         assert!((one.cauchy(2.0) + 1.0 / 3f64.sqrt()).abs() < 1e-15);
         assert!((one.cauchy(-2.0) - 1.0 / 3f64.sqrt()).abs() < 1e-15);
         // T_1: 1 − |x|/√(x²−1).
-        let t1 = UnboundedSeries { gamma: vec![0.0, 1.0] };
+        let t1 = UnboundedSeries {
+            gamma: vec![0.0, 1.0],
+        };
         assert!((t1.cauchy(1.25) - (1.0 - 1.25 / (1.25f64 * 1.25 - 1.0).sqrt())).abs() < 1e-14);
     }
 
     #[test]
     fn exterior_cauchy_matches_brute_force_quadrature() {
         // f = √(1−t²)(U_0 + 0.3 U_3), direct Gauss–Chebyshev of high order at x = 1.3.
-        let s = BoundedSeries { beta: vec![1.0, 0.0, 0.0, 0.3] };
+        let s = BoundedSeries {
+            beta: vec![1.0, 0.0, 0.0, 0.3],
+        };
         let x = 1.3;
         let n = 400;
         let direct: f64 = (1..=n)
@@ -444,7 +499,9 @@ mod tests {
             })
             .sum();
         assert!((direct - s.cauchy(x)).abs() < 1e-12);
-        let w = UnboundedSeries { gamma: vec![0.5, 0.2, -0.1] };
+        let w = UnboundedSeries {
+            gamma: vec![0.5, 0.2, -0.1],
+        };
         let direct: f64 = (1..=n)
             .map(|l| {
                 let th = ((2 * l - 1) as f64 * PI / (2.0 * n as f64)).cos();

@@ -1,0 +1,118 @@
+//! Closed-form reference solutions (the oracles of the tests).
+//!
+//! - Hertz line contact of a rigid cylinder on a half-plane of plane-strain compliance `Y*`
+//!   (`2/E*` for an elastic solid): `a² = 2PRY*/π = 4PR/(πE*)`, `p0 = 2P/(πa)`,
+//!   `p(x) = p0 √(1 − x²/a²)`.
+//! - Zhou & Lee (2012), frictionless conducting punch on a piezoelectric half-plane, in the
+//!   form derived in [`crate::contact`]: Hertz with `Y* = y22 − y23²/y33`, and
+//!   `g(x) = k p(x) + (Γ − kP)/(π √(a² − x²))`, `k = −y23/y33`.
+
+use std::f64::consts::PI;
+
+/// Hertz line contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hertz {
+    /// Half-width a (m).
+    pub half_width: f64,
+    /// Peak pressure p0 (Pa).
+    pub peak_pressure: f64,
+}
+
+impl Hertz {
+    /// For load P (N/m), radius R (m) and compliance Y* (1/Pa).
+    pub fn new(normal_load: f64, radius: f64, compliance: f64) -> Self {
+        let a = (2.0 * normal_load * radius * compliance / PI).sqrt();
+        Self {
+            half_width: a,
+            peak_pressure: 2.0 * normal_load / (PI * a),
+        }
+    }
+
+    /// p(x) (Pa), zero outside the contact.
+    pub fn pressure(&self, x: f64) -> f64 {
+        let r = x / self.half_width;
+        if r.abs() >= 1.0 {
+            0.0
+        } else {
+            self.peak_pressure * (1.0 - r * r).sqrt()
+        }
+    }
+}
+
+/// Zhou & Lee's frictionless conducting-punch solution.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ZhouLee {
+    /// The Hertzian pressure with the effective compliance.
+    pub hertz: Hertz,
+    /// k = −y23/y33 (C/N).
+    pub charge_per_force: f64,
+    /// Γ − kP (C/m).
+    pub free_charge: f64,
+}
+
+impl ZhouLee {
+    /// For P, R, Y* = y22 − y23²/y33, k and Γ.
+    pub fn new(
+        normal_load: f64,
+        radius: f64,
+        compliance: f64,
+        charge_per_force: f64,
+        charge: f64,
+    ) -> Self {
+        Self {
+            hertz: Hertz::new(normal_load, radius, compliance),
+            charge_per_force,
+            free_charge: charge - charge_per_force * normal_load,
+        }
+    }
+
+    /// g(x) (C/m²) inside the contact.
+    pub fn charge(&self, x: f64) -> f64 {
+        let a = self.hertz.half_width;
+        self.charge_per_force * self.hertz.pressure(x)
+            + self.free_charge / (PI * (a * a - x * x).sqrt())
+    }
+}
+
+/// Complete elliptic integral of the first kind `K(k) = ∫₀^{π/2} dθ/√(1 − k² sin²θ)` (modulus k),
+/// by the arithmetic–geometric mean.
+pub fn elliptic_k(k: f64) -> f64 {
+    let (mut x, mut y) = (1.0, (1.0 - k * k).sqrt());
+    for _ in 0..60 {
+        let (xn, yn) = ((x + y) / 2.0, (x * y).sqrt());
+        x = xn;
+        y = yn;
+        if (x - y).abs() < 1e-16 * x {
+            break;
+        }
+    }
+    std::f64::consts::PI / (2.0 * x)
+}
+
+/// Spence's self-similar stick zone for a Hertzian line contact in Goodman's approximation:
+/// `β/η = K'(b/a)/K(b/a)`, with `K'(k) = K(√(1 − k²))`. Returns b/a for a given β/η > 0
+/// (bisection on the monotone ratio).
+///
+/// Derivation (checked independently in the project notes): with Hertzian p, slip traction
+/// `η p sign(x)` and the strain `C|x|` in the stick zone, the stick traction is bounded with no
+/// square-root term at ±b only if this ratio holds; then
+/// `C = −(π η)/(2 R k K(k))` (for `∂ux/∂x` of the half-plane; `k = b/a`).
+pub fn spence_stick_ratio(beta_over_eta: f64) -> f64 {
+    let ratio = |k: f64| elliptic_k((1.0 - k * k).sqrt()) / elliptic_k(k);
+    let (mut lo, mut hi) = (1e-300f64, 1.0 - 1e-16);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        // ratio decreases from ∞ (k → 0) to 0 (k → 1).
+        if ratio(mid) > beta_over_eta {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// Spence's slope `C = −π η/(2 R k K(k))` of the locked-in strain (1/m), Goodman's approximation.
+pub fn spence_strain_slope(friction: f64, radius: f64, stick_ratio: f64) -> f64 {
+    -std::f64::consts::PI * friction / (2.0 * radius * stick_ratio * elliptic_k(stick_ratio))
+}

@@ -1,0 +1,467 @@
+//! Contact of a rigid cylindrical punch with the half-plane: the model, the state at one
+//! instant, field evaluation, and the surface fields of seed eqs. (64)–(65).
+//!
+//! # Conventions (fretsim's, physical)
+//! - x along the surface in the *material* frame; the punch axis is at x = 0 (its tangential
+//!   rigid displacement is of the order of the elastic displacements and is neglected in the
+//!   geometry, as in all small-strain contact theory). The contact is `[c − a, c + a]`; the
+//!   seed paper's eccentricity (punch axis relative to the contact centre) is `e = −c`.
+//! - `p` compressive positive; `q` the shear traction the punch exerts *on the half-plane*
+//!   (+x positive), so `∫q = Q` is the tangential force applied to the punch; `g = −Dz(x,0⁺)`
+//!   as in the seed paper; `uz` positive into the solid, so the rigid cylinder imposes
+//!   `∂uz/∂x = −x/R` on the contact.
+//! - The seed paper's `q` is the traction on the punch (`q_paper = −q`): its solution for a given
+//!   Q is the mirror image x → −x of ours (see [`crate::halfplane`] for the coefficient map).
+//!
+//! # Equations on the contact (from (A)–(C) of [`crate::halfplane`])
+//! Write the charge as `g = χ p + w`:
+//! - conducting punch (φ constant on the contact): `χ = k = −y23/y33` and, from (C),
+//!   `y33 H'w = −w13 q`, `∫w = Γ − kP` (seed eqs. 23, 26–29: `g1 = k p` is the part carried by
+//!   the pressure, `w = g2` the part held by the constant potential);
+//! - insulating punch: `w = 0`, `χ = Γ/P` (charge distributed like the pressure);
+//! - elastic half-plane: `χ = 0`, `w = 0`.
+//!
+//! Eliminating g from (B) gives the pressure equation (seed eqs. 21/46):
+//!
+//! ```text
+//! Y* H'p(x) = −x/R − κ q(x),   Y* = y22 + χ y23,   κ = w12 − y23 w13/y33 (conducting) or w12
+//! ```
+//!
+//! and, from (A), the tangential equation `y11 H'q = ∂ux/∂x + (w12 + χ w13) p + w13 w`.
+//! For the frictionless elastic case `Y* = 2/E*` and `p = p0 √(1 − x²/a²)`,
+//! `a² = 2PRY*/π` (Hertz). `κ/Y*` is Dundurs' β for an elastic solid.
+//!
+//! # Zhou & Lee's frictionless conducting solution (derived from seed eqs. 24–29 with q = 0)
+//! With q = 0 the pressure equation is Hertz's with compliance `Y*`: `c = 0`,
+//! `a² = 2PRY*/π`, `p = (2P/(πa²))√(a² − x²)`. The charge equation `y33 H'w = 0` with
+//! `∫w = Γ − kP` has the bounded-at-neither-end solution `w = (Γ − kP)/(π√(a² − x²))`, so
+//! `g(x) = k p(x) + (Γ − kP)/(π√(a² − x²))`. With the regularised kernel
+//! `∫₀^∞ cos(sr)/s ds → −ln(|r|/d)` (datum distance d) the contact potential is
+//! `φ0 = (ln(2d/a)/π)(y23 P + y33 Γ) − (w13/π) ∫ q(s) arcsin((s − c)/a) ds`: the weighted mean of
+//! φ over the contact with weight `1/√(a² − x²)`, exact because φ is constant there and
+//! `(1/π)∫ ln|x − s| dx/√(a² − x²) = ln(a/2)` for every s in the contact.
+//! Under potential control (φ0 given) this relation gives Γ.
+//!
+//! # Surface in-plane fields (seed eqs. 64–65, re-derived)
+//! ```text
+//! σxx0 = −Δ1 p − Δ2 g + Δ3 ∂ux/∂x,      ∂ux/∂x = −w12 p − w13 g + y11 H'q
+//! Dx0  = −(e15/c44) q − Δ4 ∂φ/∂x,        ∂φ/∂x  =  w13 q + y23 H'p + y33 H'g
+//! ```
+//! valid on and off the contact (off it p = q = g = 0 and only the Cauchy terms remain).
+
+pub mod frictionless;
+pub mod normal;
+pub mod pressure;
+
+use serde::Serialize;
+
+use crate::halfplane::{SurfaceCompliance, SurfaceFieldCoefficients};
+use crate::material::Material;
+use crate::quadrature::{BoundedSeries, UnboundedSeries};
+
+/// How the punch is connected electrically (piezoelectric half-plane only).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Electrode {
+    /// Elastic half-plane: no electric field.
+    None,
+    /// Perfectly conducting punch carrying the resultant charge Γ (C/m); φ0 is computed.
+    ConductingCharge {
+        /// Γ (C/m).
+        charge: f64,
+    },
+    /// Perfectly conducting punch held at potential φ0 (V) relative to the datum; Γ is computed.
+    ConductingPotential {
+        /// φ0 (V).
+        potential: f64,
+    },
+    /// Insulating punch carrying Γ (C/m), distributed like the pressure, `g = (Γ/P) p`.
+    Insulating {
+        /// Γ (C/m).
+        charge: f64,
+    },
+}
+
+/// Whether the shear traction is fed back into the pressure equation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, serde::Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum Coupling {
+    /// Full coupling (κ as derived).
+    #[default]
+    Full,
+    /// Goodman's approximation: κ = 0 in the pressure equation (q does not change p).
+    Goodman,
+}
+
+/// Everything that defines the contact except the loads and the history.
+#[derive(Debug, Clone, Serialize)]
+pub struct ContactModel {
+    /// The half-plane.
+    pub material: Material,
+    /// Surface compliance coefficients derived from the material.
+    pub compliance: SurfaceCompliance,
+    /// Δ1…Δ4 for the surface fields.
+    pub field_coefficients: SurfaceFieldCoefficients,
+    /// Punch radius R (m).
+    pub radius: f64,
+    /// Coulomb friction coefficient η (–).
+    pub friction: f64,
+    /// Electric boundary condition of the punch.
+    pub electrode: Electrode,
+    /// Datum distance d of the regularised log kernel (m), for φ0 and the displacement δ.
+    pub reference_distance: f64,
+    /// Shear–pressure coupling.
+    pub coupling: Coupling,
+}
+
+/// How the charge is split, `g = χ p + w`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ChargeSplit {
+    /// χ (C/N).
+    pub ratio: f64,
+    /// Whether the constant-potential part `w` is present (conducting punch).
+    pub conducting: bool,
+}
+
+impl ContactModel {
+    /// A model with the coefficients derived from `material`.
+    pub fn new(material: Material, radius: f64, friction: f64, electrode: Electrode) -> Self {
+        Self {
+            compliance: SurfaceCompliance::of(&material),
+            field_coefficients: SurfaceFieldCoefficients::of(&material),
+            material,
+            radius,
+            friction,
+            electrode,
+            reference_distance: 1e-2,
+            coupling: Coupling::Full,
+        }
+    }
+
+    /// With a datum distance d (m).
+    pub fn with_reference_distance(mut self, d: f64) -> Self {
+        self.reference_distance = d;
+        self
+    }
+
+    /// With the given shear–pressure coupling.
+    pub fn with_coupling(mut self, coupling: Coupling) -> Self {
+        self.coupling = coupling;
+        self
+    }
+
+    /// χ and the conducting flag at normal load P.
+    pub fn charge_split(&self, normal_load: f64) -> ChargeSplit {
+        match self.electrode {
+            Electrode::None => ChargeSplit {
+                ratio: 0.0,
+                conducting: false,
+            },
+            Electrode::ConductingCharge { .. } | Electrode::ConductingPotential { .. } => {
+                ChargeSplit {
+                    ratio: self.compliance.charge_per_force(),
+                    conducting: true,
+                }
+            }
+            Electrode::Insulating { charge } => ChargeSplit {
+                ratio: charge / normal_load,
+                conducting: false,
+            },
+        }
+    }
+
+    /// `Y* = y22 + χ y23` (1/Pa).
+    pub fn pressure_compliance(&self, split: ChargeSplit) -> f64 {
+        let y23 = self.compliance.electric.map_or(0.0, |e| e.y23);
+        self.compliance.y22 + split.ratio * y23
+    }
+
+    /// κ of the pressure equation (zero under Goodman's approximation).
+    pub fn pressure_shear_coupling(&self, split: ChargeSplit) -> f64 {
+        match self.coupling {
+            Coupling::Goodman => 0.0,
+            Coupling::Full if split.conducting => self.compliance.pressure_shear_coupling(),
+            Coupling::Full => self.compliance.w12,
+        }
+    }
+
+    /// Local coefficient of p in `−∂ux/∂x`: `w12 + χ w13`.
+    pub fn local_pressure_strain(&self, split: ChargeSplit) -> f64 {
+        self.compliance.w12 + split.ratio * self.compliance.electric.map_or(0.0, |e| e.w13)
+    }
+
+    /// Charge Γ1 = kP carried by the pressure under a conducting punch (C/m).
+    pub fn pressure_charge(&self, normal_load: f64) -> f64 {
+        self.compliance.charge_per_force() * normal_load
+    }
+}
+
+/// The shear traction on the contact: `q = η p S(x) + q̃(x)` (see module docs of the solvers).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Traction {
+    /// Friction coefficient η used in the slip zones.
+    pub friction: f64,
+    /// Sign of `q/(ηp)` in the left slip zone `[c − a, lo)`.
+    pub left_sign: f64,
+    /// Sign of `q/(ηp)` in the right slip zone `(hi, c + a]`.
+    pub right_sign: f64,
+    /// Stick zone and its correction, `None` when the contact is frictionless.
+    pub stick: Option<StickZone>,
+}
+
+/// The stick zone `[lo, hi]` and the bounded correction `q̃` on it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StickZone {
+    /// Left end (m).
+    pub lo: f64,
+    /// Right end (m).
+    pub hi: f64,
+    /// Smooth part of `q̃((x − mid)/half)` (Pa).
+    pub correction: BoundedSeries,
+    /// Amplitude A of the kink part `A·k(u)` of q̃ (Pa), see [`kink_density`]; non-zero only
+    /// for the normal-loading state, whose memory `C|x|` has a kink at the centre.
+    pub kink: f64,
+}
+
+/// `k(u) = −(2u/π) artanh √(1 − u²)`: the bounded solution of
+/// `(1/π)⨍ k(t)/(t − u) dt = |u| − 2/π` on (−1, 1). Its U-series coefficients decay only like
+/// n⁻², so it is kept in closed form; `k(u)/√(1−u²) → −2/π` at u = ±1.
+pub fn kink_density(u: f64) -> f64 {
+    if u.abs() >= 1.0 || u == 0.0 {
+        return 0.0;
+    }
+    // artanh √(1 − u²) = ln((1 + √(1 − u²))/|u|), finite for every u ≠ 0.
+    -2.0 * u / std::f64::consts::PI * ((1.0 + (1.0 - u * u).sqrt()).ln() - u.abs().ln())
+}
+
+/// `(1/π)⨍ k(t)/(t − u) dt`: `|u| − 2/π` inside, `(2/π)((|z| + 1/|z|) arctan|z| − 1)` outside,
+/// `z = u − sgn(u)√(u² − 1)`.
+pub fn kink_cauchy(u: f64) -> f64 {
+    let two_over_pi = 2.0 / std::f64::consts::PI;
+    if u.abs() <= 1.0 {
+        u.abs() - two_over_pi
+    } else {
+        let z = (u.abs() - (u * u - 1.0).sqrt()).max(1e-300);
+        two_over_pi * ((z + 1.0 / z) * z.atan() - 1.0)
+    }
+}
+
+impl StickZone {
+    /// q̃ at x (Pa).
+    pub fn correction_at(&self, x: f64) -> f64 {
+        let u = (x - self.mid()) / self.half();
+        self.correction.density(u) + self.kink * kink_density(u)
+    }
+
+    /// `H'q̃(x)` (Pa).
+    pub fn correction_cauchy(&self, x: f64) -> f64 {
+        let u = (x - self.mid()) / self.half();
+        self.correction.cauchy(u) + self.kink * kink_cauchy(u)
+    }
+}
+
+impl StickZone {
+    /// Centre of the zone (m).
+    pub fn mid(&self) -> f64 {
+        0.5 * (self.lo + self.hi)
+    }
+    /// Half-width (m).
+    pub fn half(&self) -> f64 {
+        0.5 * (self.hi - self.lo)
+    }
+}
+
+/// The solution at one instant.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ContactState {
+    /// Normal load P (N/m).
+    pub normal_load: f64,
+    /// Tangential load Q (N/m).
+    pub tangential_load: f64,
+    /// Resultant charge Γ on the punch (C/m).
+    pub charge: f64,
+    /// Contact potential φ0 relative to the datum (V), conducting punch only.
+    pub potential: Option<f64>,
+    /// Contact half-width a (m).
+    pub half_width: f64,
+    /// Contact centre c in the material frame (m); eccentricity e = −c.
+    pub centre: f64,
+    /// Pressure on the contact, `p(x) = density((x − c)/a)` (Pa).
+    pub pressure: BoundedSeries,
+    /// Charge split.
+    pub split: ChargeSplit,
+    /// Constant-potential charge `w((x − c)/a)` (C/m²); empty unless conducting.
+    pub potential_charge: UnboundedSeries,
+    /// Shear traction.
+    pub traction: Traction,
+}
+
+impl ContactState {
+    /// Normalised position on the contact.
+    fn tau(&self, x: f64) -> f64 {
+        (x - self.centre) / self.half_width
+    }
+
+    /// Whether x lies inside the contact.
+    pub fn in_contact(&self, x: f64) -> bool {
+        self.tau(x).abs() < 1.0
+    }
+
+    /// Pressure p(x) (Pa).
+    pub fn pressure_at(&self, x: f64) -> f64 {
+        self.pressure.density(self.tau(x))
+    }
+
+    /// Charge g(x) = χ p + w (C/m²).
+    pub fn charge_at(&self, x: f64) -> f64 {
+        self.split.ratio * self.pressure_at(x) + self.potential_charge.density(self.tau(x))
+    }
+
+    /// The slip-direction function S(x): the left/right signs outside the stick zone and the
+    /// smoothstep `s_L + (s_R − s_L)(3v² − 2v³)`, `v = (x − lo)/(hi − lo)`, inside it. Its zero
+    /// slope at the stick ends makes `q̃ = q − ηpS` vanish like `(b − x)^{3/2}` there (a linear
+    /// blend, as in the seed paper's eq. 17, leaves a `(b − x)` term whose square-root quotient
+    /// limits the end condition to first order in 1/M).
+    pub fn slip_shape(&self, x: f64) -> f64 {
+        let t = &self.traction;
+        match &t.stick {
+            None => 0.0,
+            Some(s) if x <= s.lo => t.left_sign,
+            Some(s) if x >= s.hi => t.right_sign,
+            Some(s) => {
+                let v = (x - s.lo) / (s.hi - s.lo);
+                t.left_sign + (t.right_sign - t.left_sign) * v * v * (3.0 - 2.0 * v)
+            }
+        }
+    }
+
+    /// Shear traction q(x) (Pa).
+    pub fn traction_at(&self, x: f64) -> f64 {
+        let t = &self.traction;
+        let Some(stick) = &t.stick else { return 0.0 };
+        let base = t.friction * self.pressure_at(x) * self.slip_shape(x);
+        base + stick.correction_at(x)
+    }
+
+    /// `H'p(x) = (1/π)⨍ p(s)/(s − x) ds` from the representation (Pa), any x off the ends.
+    pub fn pressure_cauchy(&self, x: f64) -> f64 {
+        self.pressure.cauchy(self.tau(x))
+    }
+
+    /// `H'g(x)` (C/m²).
+    pub fn charge_cauchy(&self, x: f64) -> f64 {
+        let t = self.tau(x);
+        self.split.ratio * self.pressure.cauchy(t) + self.potential_charge.cauchy(t)
+    }
+
+    /// `H'(pS)(x) = S(x) H'p(x) + (1/π)∫ p(t)(S(t) − S(x))/(t − x) dt`: the Cauchy transform of
+    /// the friction-limited part of the traction per unit η. The integrand is a bounded
+    /// difference quotient; it is integrated piecewise over the slip and stick intervals with
+    /// sine-graded Gauss–Legendre rules (which also absorb the √ at the contact ends). When
+    /// both slip zones have the same sign S is constant and the integral vanishes.
+    pub fn shape_cauchy(&self, x: f64) -> f64 {
+        let t = &self.traction;
+        let Some(stick) = &t.stick else { return 0.0 };
+        let sx = self.slip_shape(x);
+        let mut value = sx * self.pressure_cauchy(x);
+        if (t.left_sign - t.right_sign).abs() > 0.0 {
+            let ends = [
+                self.centre - self.half_width,
+                stick.lo,
+                stick.hi,
+                self.centre + self.half_width,
+            ];
+            let (nodes, weights) = graded_rule();
+            let mut sum = 0.0;
+            for seg in ends.windows(2) {
+                let (lo, hi) = (seg[0], seg[1]);
+                let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+                for (u, w) in nodes.iter().zip(weights) {
+                    let tt = mid + half * u;
+                    let quotient = if (tt - x).abs() > 1e-14 * self.half_width {
+                        (self.slip_shape(tt) - sx) / (tt - x)
+                    } else {
+                        0.0
+                    };
+                    sum += w * half * self.pressure_at(tt) * quotient;
+                }
+            }
+            value += sum / std::f64::consts::PI;
+        }
+        value
+    }
+
+    /// `H'q(x) = η H'(pS)(x) + H'q̃(x)` (Pa), on and off the contact.
+    pub fn traction_cauchy(&self, x: f64) -> f64 {
+        let t = &self.traction;
+        let Some(stick) = &t.stick else { return 0.0 };
+        t.friction * self.shape_cauchy(x) + stick.correction_cauchy(x)
+    }
+
+    /// Surface strain `∂ux/∂x` from eq. (A): `−(w12 + χ w13) p − w13 w + y11 H'q`.
+    pub fn strain_at(&self, model: &ContactModel, x: f64) -> f64 {
+        let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
+        let tau = self.tau(x);
+        -model.local_pressure_strain(self.split) * self.pressure_at(x)
+            - w13 * self.potential_charge.density(tau)
+            + model.compliance.y11 * self.traction_cauchy(x)
+    }
+}
+
+/// Sine-graded Gauss–Legendre rule on [−1, 1]: `u = sin(πv/2)`, nodes clustered like
+/// Chebyshev points at both ends (resolves √ end behaviour and near-singular quotients).
+pub fn graded_rule() -> &'static (Vec<f64>, Vec<f64>) {
+    static RULE: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
+    RULE.get_or_init(|| {
+        let (v, w) = crate::quadrature::gauss_legendre(96);
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        let nodes = v.iter().map(|v| (half_pi * v).sin()).collect();
+        let weights = v
+            .iter()
+            .zip(&w)
+            .map(|(v, w)| w * half_pi * (half_pi * v).cos())
+            .collect();
+        (nodes, weights)
+    })
+}
+
+/// Surface fields at one point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SurfacePoint {
+    /// x (m).
+    pub x: f64,
+    /// p (Pa).
+    pub pressure: f64,
+    /// q (Pa).
+    pub traction: f64,
+    /// g (C/m²).
+    pub charge: f64,
+    /// σxx0 (Pa).
+    pub sigma_xx: f64,
+    /// Dx0 (C/m²).
+    pub d_x: f64,
+}
+
+impl ContactModel {
+    /// p, q, g, σxx0 and Dx0 at x (seed eqs. 64–65, module docs).
+    pub fn surface_point(&self, state: &ContactState, x: f64) -> SurfacePoint {
+        let c = &self.compliance;
+        let d = &self.field_coefficients;
+        let (y23, y33, w13) = c
+            .electric
+            .map_or((0.0, 0.0, 0.0), |e| (e.y23, e.y33, e.w13));
+        let p = state.pressure_at(x);
+        let q = state.traction_at(x);
+        let g = state.charge_at(x);
+        let dux = state.strain_at(self, x);
+        let dphi = w13 * q + y23 * state.pressure_cauchy(x) + y33 * state.charge_cauchy(x);
+        SurfacePoint {
+            x,
+            pressure: p,
+            traction: q,
+            charge: g,
+            sigma_xx: -d.delta1 * p - d.delta2 * g + d.delta3 * dux,
+            d_x: -d.e15_over_c44 * q - d.delta4 * dphi,
+        }
+    }
+}

@@ -1,0 +1,191 @@
+//! The pressure and charge sub-problems for a given shear traction, shared by every solver
+//! state (seed eqs. 24–29, 37–42, 52–57).
+//!
+//! Pressure (bounded at both contact ends), on `x = c + aτ`:
+//!
+//! ```text
+//! (1/π)⨍ p(θ)/(θ − τ) dθ = −(c + aτ)/(R Y*) − (κ/Y*) q(c + aτ),     ∫ p dx = P
+//! ```
+//!
+//! Writing `p = a ψ₁ + ψ_q` with `ψ₁` the response to `−τ/(RY*)` and `ψ_q` the response to the
+//! shear term, the consistency condition (zero discrete Chebyshev mean of the right-hand side)
+//! gives `c = R Y* mean(−(κ/Y*) q)` and the resultant gives the quadratic
+//! `a² I₁ + a I_q = P` (`I` the integrals of ψ over θ). Because q is sampled at the new points,
+//! (a, c) are iterated to a fixed point; without shear coupling one pass is exact.
+//!
+//! Charge (conducting punch), on the unbounded grid:
+//! `(1/π)⨍ w(θ)/(θ − τ) dθ = −(w13/y33) q(c + aτ)`, `∫ w dx = Γ − kP`.
+
+use crate::error::SolveFailure;
+use crate::quadrature::{BoundedGrid, BoundedSeries, UnboundedGrid, UnboundedSeries};
+
+use super::{ChargeSplit, ContactModel};
+
+/// The factored collocation matrices of a run (depend only on M).
+#[derive(Debug, Clone)]
+pub struct Discretisation {
+    /// Grid for bounded densities (pressure, stick-zone traction).
+    pub bounded: BoundedGrid,
+    /// Grid for the inverse-square-root charge.
+    pub unbounded: UnboundedGrid,
+    /// ψ₁: response to `−τ` (unit `1/(RY*)`), with its integral.
+    unit_psi: Vec<f64>,
+    unit_integral: f64,
+}
+
+impl Discretisation {
+    /// Build and factor for M collocation nodes.
+    pub fn new(m: usize) -> Self {
+        let bounded = BoundedGrid::new(m);
+        let unbounded = UnboundedGrid::new(m);
+        let rhs: Vec<f64> = bounded.collocation.iter().map(|t| -t).collect();
+        let mut unit_psi = vec![0.0; m];
+        bounded.solve(&rhs, &mut unit_psi);
+        let unit_integral = bounded.integral(&unit_psi);
+        Self {
+            bounded,
+            unbounded,
+            unit_psi,
+            unit_integral,
+        }
+    }
+
+    /// Number of nodes M.
+    pub fn nodes(&self) -> usize {
+        self.bounded.len()
+    }
+}
+
+/// Solution of the pressure sub-problem.
+#[derive(Debug, Clone)]
+pub struct PressureSolution {
+    /// Half-width a (m).
+    pub half_width: f64,
+    /// Centre c (m).
+    pub centre: f64,
+    /// Pressure representation (Pa).
+    pub pressure: BoundedSeries,
+    /// Fixed-point iterations used for (a, c).
+    pub iterations: usize,
+}
+
+/// Solve the pressure for the shear traction `q(x)` (material coordinates), starting from
+/// the guess `(a, c)`.
+pub fn solve_pressure(
+    model: &ContactModel,
+    disc: &Discretisation,
+    split: ChargeSplit,
+    normal_load: f64,
+    traction: &dyn Fn(f64) -> f64,
+    guess: (f64, f64),
+) -> Result<PressureSolution, SolveFailure> {
+    let m = disc.nodes();
+    let ystar = model.pressure_compliance(split);
+    let kappa = model.pressure_shear_coupling(split);
+    let scale = 1.0 / (model.radius * ystar);
+    let i1 = disc.unit_integral * scale;
+    let (mut a, mut c) = guess;
+    if !(a.is_finite() && a > 0.0) {
+        a = (normal_load / i1).sqrt();
+        c = 0.0;
+    }
+    let mut rhs = vec![0.0; m + 1];
+    let mut psi_q = vec![0.0; m];
+    let coupled = kappa != 0.0;
+    let max_iter = 100;
+    for iter in 1..=max_iter {
+        let (lambda, iq) = if coupled {
+            for (r, &t) in rhs.iter_mut().zip(&disc.bounded.collocation) {
+                *r = -kappa / ystar * traction(c + a * t);
+            }
+            let lambda = disc.bounded.solve(&rhs, &mut psi_q);
+            (lambda, disc.bounded.integral(&psi_q))
+        } else {
+            (0.0, 0.0)
+        };
+        let c_new = lambda / scale;
+        let a_new = (-iq + (iq * iq + 4.0 * i1 * normal_load).sqrt()) / (2.0 * i1);
+        if !(a_new.is_finite() && c_new.is_finite()) {
+            return Err(SolveFailure::NonFinite {
+                field: "contact half-width",
+            });
+        }
+        let change = ((a_new - a).abs() + (c_new - c).abs()) / a_new;
+        a = a_new;
+        c = c_new;
+        if !coupled || change < 1e-14 {
+            let psi: Vec<f64> = disc
+                .unit_psi
+                .iter()
+                .zip(&psi_q)
+                .map(|(u, q)| a * scale * u + if coupled { *q } else { 0.0 })
+                .collect();
+            return Ok(PressureSolution {
+                half_width: a,
+                centre: c,
+                pressure: BoundedSeries::from_nodes(&disc.bounded, &psi),
+                iterations: iter,
+            });
+        }
+    }
+    Err(SolveFailure::NoConvergence {
+        what: "contact half-width and centre",
+        iterations: max_iter,
+        residual: f64::NAN,
+    })
+}
+
+/// Solve the constant-potential charge `w` of a conducting punch on the contact `[c − a, c + a]`
+/// with resultant `free_charge = Γ − kP`.
+pub fn solve_potential_charge(
+    model: &ContactModel,
+    disc: &Discretisation,
+    half_width: f64,
+    centre: f64,
+    free_charge: f64,
+    traction: &dyn Fn(f64) -> f64,
+) -> UnboundedSeries {
+    let m = disc.nodes();
+    let e = model
+        .compliance
+        .electric
+        .expect("conducting punch needs a piezoelectric half-plane");
+    let rhs: Vec<f64> = disc
+        .unbounded
+        .collocation
+        .iter()
+        .map(|&t| -e.w13 / e.y33 * traction(centre + half_width * t))
+        .collect();
+    let mut theta = vec![0.0; m];
+    disc.unbounded
+        .solve(&rhs, free_charge / half_width, &mut theta);
+    UnboundedSeries::from_nodes(&disc.unbounded, &theta)
+}
+
+/// `φ0 = (ln(2d/a)/π)(y23 P + y33 Γ) − (w13/π) J_q`, with `J_q = ∫ q(s) arcsin((s − c)/a) ds`
+/// supplied by the caller (module docs of [`crate::contact`]).
+pub fn contact_potential(
+    model: &ContactModel,
+    half_width: f64,
+    normal_load: f64,
+    charge: f64,
+    j_q: f64,
+) -> f64 {
+    let e = model.compliance.electric.expect("piezoelectric half-plane");
+    let log = (2.0 * model.reference_distance / half_width).ln();
+    log / std::f64::consts::PI * (e.y23 * normal_load + e.y33 * charge)
+        - e.w13 / std::f64::consts::PI * j_q
+}
+
+/// Inverse of [`contact_potential`] for Γ.
+pub fn charge_for_potential(
+    model: &ContactModel,
+    half_width: f64,
+    normal_load: f64,
+    potential: f64,
+    j_q: f64,
+) -> f64 {
+    let e = model.compliance.electric.expect("piezoelectric half-plane");
+    let log = (2.0 * model.reference_distance / half_width).ln();
+    (std::f64::consts::PI * potential + e.w13 * j_q - log * e.y23 * normal_load) / (log * e.y33)
+}

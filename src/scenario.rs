@@ -1,0 +1,437 @@
+//! Scenario files: the raw serde shape (strict: unknown fields are errors), and validation into
+//! a [`Scenario`] that collects *every* problem with its JSON path.
+//!
+//! All quantities are SI: N/m for line loads (plane strain), m, Pa, C/m (line charge), V.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::contact::{ContactModel, Coupling, Electrode};
+use crate::error::{Error, Issue};
+use crate::material::{IsotropicConstants, Material, PiezoConstants, preset};
+
+/// Scenario as written in the file.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawScenario {
+    /// Name, used for the default output folder `output/<name>/`.
+    #[serde(default = "default_name")]
+    pub name: String,
+    /// The half-plane.
+    pub material: RawMaterial,
+    /// The punch.
+    pub punch: RawPunch,
+    /// Coulomb friction coefficient η (–), ≥ 0.
+    pub friction: f64,
+    /// Normal load P (N/m), > 0.
+    pub normal_load: f64,
+    /// Datum distance d of the regularised log kernel (m), > 0 (default 0.01 m).
+    #[serde(default = "default_reference_distance")]
+    pub reference_distance: f64,
+    /// Shear–pressure coupling: `full` (default) or `goodman`.
+    #[serde(default)]
+    pub coupling: Coupling,
+    /// Numerical settings.
+    #[serde(default)]
+    pub numerics: RawNumerics,
+}
+
+fn default_name() -> String {
+    "scenario".to_string()
+}
+
+fn default_reference_distance() -> f64 {
+    1e-2
+}
+
+/// Material: a preset by name, or constants.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum RawMaterial {
+    /// `{"kind": "preset", "name": "pzt4"}`.
+    Preset {
+        /// Preset name (`fretsim materials` lists them).
+        name: String,
+    },
+    /// `{"kind": "piezoelectric", "c11": …, …}` (Pa, C/m², C/(V·m)).
+    Piezoelectric(PiezoConstants),
+    /// `{"kind": "elastic", "shear_modulus" or "youngs_modulus": …, "poisson_ratio": …}`.
+    Elastic {
+        /// μ (Pa).
+        #[serde(default)]
+        shear_modulus: Option<f64>,
+        /// E (Pa).
+        #[serde(default)]
+        youngs_modulus: Option<f64>,
+        /// ν (–).
+        poisson_ratio: f64,
+    },
+}
+
+/// The punch.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPunch {
+    /// Radius R (m), > 0.
+    pub radius: f64,
+    /// Electric boundary condition (default: none, for an elastic half-plane).
+    #[serde(default)]
+    pub electrode: RawElectrode,
+}
+
+/// Electrode model.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum RawElectrode {
+    /// No electric load (elastic half-plane).
+    #[default]
+    None,
+    /// Conducting punch with either `charge` Γ (C/m) or `potential` φ0 (V).
+    Conducting {
+        /// Γ (C/m).
+        #[serde(default)]
+        charge: Option<f64>,
+        /// φ0 (V).
+        #[serde(default)]
+        potential: Option<f64>,
+    },
+    /// Insulating punch with charge Γ (C/m) distributed like the pressure.
+    Insulating {
+        /// Γ (C/m).
+        charge: f64,
+    },
+}
+
+/// Numerical settings.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawNumerics {
+    /// Number of collocation nodes M per interval (8 ≤ M ≤ 1024, default 64).
+    #[serde(default = "default_m")]
+    pub collocation_points: usize,
+}
+
+fn default_m() -> usize {
+    64
+}
+
+impl Default for RawNumerics {
+    fn default() -> Self {
+        Self {
+            collocation_points: default_m(),
+        }
+    }
+}
+
+/// A validated scenario.
+#[derive(Debug, Clone, Serialize)]
+pub struct Scenario {
+    /// Name.
+    pub name: String,
+    /// The contact model.
+    pub model: ContactModel,
+    /// Normal load P (N/m).
+    pub normal_load: f64,
+    /// M.
+    pub collocation_points: usize,
+    /// The input as read, echoed in the outputs.
+    pub raw: RawScenario,
+}
+
+/// The built-in default: the seed paper's baseline (PZT-4, conducting punch, R = 60 mm,
+/// P = 2000 N/m, Γ = 6e−7 C/m, η = 0.3).
+pub const DEFAULT_SCENARIO: &str = r#"{
+  "name": "baseline",
+  "material": { "kind": "preset", "name": "pzt4" },
+  "punch": { "radius": 0.06, "electrode": { "kind": "conducting", "charge": 6e-7 } },
+  "friction": 0.3,
+  "normal_load": 2000.0
+}"#;
+
+/// Parse a scenario from JSON text; `path` names the source in messages.
+pub fn parse(text: &str, path: &Path) -> Result<RawScenario, Error> {
+    let de = &mut serde_json::Deserializer::from_str(text);
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let at = e.path().to_string();
+        let inner = e.into_inner();
+        Error::ParseScenario {
+            path: path.to_path_buf(),
+            at,
+            line: inner.line(),
+            column: inner.column(),
+            message: inner.to_string(),
+        }
+    })
+}
+
+/// Read, parse and validate a scenario file.
+pub fn load(path: &Path) -> Result<Scenario, Error> {
+    let text = std::fs::read_to_string(path).map_err(|source| Error::ReadScenario {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let raw = parse(&text, path)?;
+    validate(raw).map_err(|issues| Error::InvalidScenario {
+        path: path.to_path_buf(),
+        issues,
+    })
+}
+
+/// The built-in default scenario, validated.
+pub fn default_scenario() -> Scenario {
+    let raw = parse(DEFAULT_SCENARIO, Path::new("<built-in>")).expect("built-in scenario parses");
+    validate(raw).expect("built-in scenario is valid")
+}
+
+fn positive(issues: &mut Vec<Issue>, path: &str, value: f64, unit: &str) {
+    if !(value.is_finite() && value > 0.0) {
+        issues.push(Issue::new(
+            path,
+            format!("{value} {unit} is invalid; it must be finite and > 0"),
+        ));
+    }
+}
+
+/// Check every rule; return all problems at once.
+pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
+    let mut issues = Vec::new();
+    let material = match &raw.material {
+        RawMaterial::Preset { name } => match preset(name) {
+            Some(p) => Some(p.material),
+            None => {
+                let names: Vec<_> = crate::material::presets().iter().map(|p| p.name).collect();
+                issues.push(Issue::new(
+                    "material.name",
+                    format!(
+                        "\"{name}\" is invalid; it must be one of {}",
+                        names.join(", ")
+                    ),
+                ));
+                None
+            }
+        },
+        RawMaterial::Piezoelectric(c) => Some(Material::Piezoelectric(*c)),
+        RawMaterial::Elastic {
+            shear_modulus,
+            youngs_modulus,
+            poisson_ratio,
+        } => match (shear_modulus, youngs_modulus) {
+            (Some(mu), None) => Some(Material::Elastic(IsotropicConstants {
+                shear_modulus: *mu,
+                poisson_ratio: *poisson_ratio,
+            })),
+            (None, Some(e)) => {
+                if !(e.is_finite() && *e > 0.0) {
+                    issues.push(Issue::new(
+                        "material.youngs_modulus",
+                        format!("{e} Pa is invalid; it must be finite and > 0"),
+                    ));
+                    None
+                } else {
+                    Some(Material::Elastic(IsotropicConstants::from_youngs(
+                        *e,
+                        *poisson_ratio,
+                    )))
+                }
+            }
+            _ => {
+                issues.push(Issue::new(
+                    "material",
+                    "an elastic material is invalid without exactly one of `shear_modulus` and `youngs_modulus`",
+                ));
+                None
+            }
+        },
+    };
+    if let Some(m) = &material {
+        let prefix = match raw.material {
+            RawMaterial::Preset { .. } => "material.name",
+            _ => "material",
+        };
+        issues.extend(m.validate(prefix));
+    }
+    positive(&mut issues, "punch.radius", raw.punch.radius, "m");
+    positive(&mut issues, "normal_load", raw.normal_load, "N/m");
+    positive(
+        &mut issues,
+        "reference_distance",
+        raw.reference_distance,
+        "m",
+    );
+    if !(raw.friction.is_finite() && raw.friction >= 0.0) {
+        issues.push(Issue::new(
+            "friction",
+            format!("{} is invalid; it must be finite and ≥ 0", raw.friction),
+        ));
+    }
+    let m = raw.numerics.collocation_points;
+    if !(8..=1024).contains(&m) {
+        issues.push(Issue::new(
+            "numerics.collocation_points",
+            format!("{m} is invalid; it must lie in [8, 1024]"),
+        ));
+    }
+    let piezo = material.map(|m| m.is_piezoelectric());
+    let electrode = match (&raw.punch.electrode, piezo) {
+        (RawElectrode::None, Some(true)) => {
+            issues.push(Issue::new(
+                "punch.electrode",
+                "none is invalid for a piezoelectric half-plane; it must be `conducting` or `insulating`",
+            ));
+            None
+        }
+        (RawElectrode::None, _) => Some(Electrode::None),
+        (_, Some(false)) => {
+            issues.push(Issue::new(
+                "punch.electrode",
+                "an electric load is invalid for an elastic half-plane; it must be {\"kind\": \"none\"} or omitted",
+            ));
+            None
+        }
+        (RawElectrode::Conducting { charge, potential }, _) => match (charge, potential) {
+            (Some(g), None) if g.is_finite() => Some(Electrode::ConductingCharge { charge: *g }),
+            (None, Some(v)) if v.is_finite() => {
+                Some(Electrode::ConductingPotential { potential: *v })
+            }
+            (Some(g), None) => {
+                issues.push(Issue::new(
+                    "punch.electrode.charge",
+                    format!("{g} C/m is invalid; it must be finite"),
+                ));
+                None
+            }
+            (None, Some(v)) => {
+                issues.push(Issue::new(
+                    "punch.electrode.potential",
+                    format!("{v} V is invalid; it must be finite"),
+                ));
+                None
+            }
+            _ => {
+                issues.push(Issue::new(
+                    "punch.electrode",
+                    "a conducting punch is invalid without exactly one of `charge` (C/m) and `potential` (V)",
+                ));
+                None
+            }
+        },
+        (RawElectrode::Insulating { charge }, _) => {
+            if charge.is_finite() {
+                Some(Electrode::Insulating { charge: *charge })
+            } else {
+                issues.push(Issue::new(
+                    "punch.electrode.charge",
+                    format!("{charge} C/m is invalid; it must be finite"),
+                ));
+                None
+            }
+        }
+    };
+    match (material, electrode, issues.is_empty()) {
+        (Some(material), Some(electrode), true) => {
+            let model = ContactModel::new(material, raw.punch.radius, raw.friction, electrode)
+                .with_reference_distance(raw.reference_distance)
+                .with_coupling(raw.coupling);
+            Ok(Scenario {
+                name: raw.name.clone(),
+                model,
+                normal_load: raw.normal_load,
+                collocation_points: m,
+                raw,
+            })
+        }
+        _ => Err(issues),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(text: &str) -> Result<Scenario, Error> {
+        let raw = parse(text, Path::new("t.json"))?;
+        validate(raw).map_err(|issues| Error::InvalidScenario {
+            path: "t.json".into(),
+            issues,
+        })
+    }
+
+    fn issues(text: &str) -> Vec<Issue> {
+        match check(text) {
+            Err(Error::InvalidScenario { issues, .. }) => issues,
+            other => panic!("expected invalid scenario, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn default_scenario_is_the_paper_baseline() {
+        let s = default_scenario();
+        assert_eq!(s.name, "baseline");
+        assert!(
+            matches!(s.model.electrode, Electrode::ConductingCharge { charge } if (charge - 6e-7).abs() < 1e-20)
+        );
+    }
+
+    #[test]
+    fn unknown_field_is_named_with_line_and_column() {
+        let text = "{\n \"frictoin\": 0.3 }";
+        match check(text) {
+            Err(Error::ParseScenario { message, line, .. }) => {
+                assert!(message.contains("frictoin"), "{message}");
+                assert_eq!(line, 2);
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn wrong_type_names_the_json_path() {
+        let text = DEFAULT_SCENARIO.replace("\"radius\": 0.06", "\"radius\": \"big\"");
+        match check(&text) {
+            Err(Error::ParseScenario { at, .. }) => assert_eq!(at, "punch.radius"),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn every_problem_is_collected() {
+        let text = DEFAULT_SCENARIO
+            .replace("\"radius\": 0.06", "\"radius\": -0.06")
+            .replace("\"friction\": 0.3", "\"friction\": -1")
+            .replace("\"normal_load\": 2000.0", "\"normal_load\": 0");
+        let paths: Vec<_> = issues(&text).into_iter().map(|i| i.path).collect();
+        assert_eq!(paths, ["punch.radius", "normal_load", "friction"]);
+        let msg = issues(&text)[0].to_string();
+        assert_eq!(
+            msg,
+            "`punch.radius` = -0.06 m is invalid; it must be finite and > 0"
+        );
+    }
+
+    #[test]
+    fn electric_load_on_elastic_material_is_rejected() {
+        let text = r#"{"material": {"kind": "elastic", "shear_modulus": 27.3e9, "poisson_ratio": 0.3},
+            "punch": {"radius": 0.01, "electrode": {"kind": "conducting", "charge": 1e-7}},
+            "friction": 0.3, "normal_load": 2240}"#;
+        assert_eq!(issues(text)[0].path, "punch.electrode");
+    }
+
+    #[test]
+    fn unknown_preset_and_bad_constants_are_named() {
+        let text = DEFAULT_SCENARIO.replace("\"pzt4\"", "\"pzt99\"");
+        assert_eq!(issues(&text)[0].path, "material.name");
+        let text = r#"{"material": {"kind": "piezoelectric", "c11": 139e9, "c13": 74.3e9, "c33": 115e9, "c44": -1,
+            "e31": -5.2, "e33": 15.1, "e15": 12.7, "eps11": 6.461e-9, "eps33": 5.62e-9},
+            "punch": {"radius": 0.06, "electrode": {"kind": "conducting", "charge": 6e-7}},
+            "friction": 0.3, "normal_load": 2000}"#;
+        assert_eq!(issues(text)[0].path, "material.c44");
+    }
+
+    #[test]
+    fn conducting_needs_exactly_one_electric_load() {
+        let text =
+            DEFAULT_SCENARIO.replace("\"charge\": 6e-7", "\"charge\": 6e-7, \"potential\": 1.0");
+        assert_eq!(issues(&text)[0].path, "punch.electrode");
+    }
+}

@@ -1,0 +1,156 @@
+//! The command line end to end, each test in its own temporary folder.
+
+use std::path::Path;
+use std::process::Command;
+
+use serde::Deserialize;
+
+fn fretsim() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_fretsim"))
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Normal {
+    half_width: f64,
+    eccentricity: f64,
+    stick_half_width: f64,
+    stick_ratio: f64,
+    strain_slope: f64,
+    peak_pressure: f64,
+    charge: f64,
+    potential: Option<f64>,
+    pressure_resultant: f64,
+    charge_resultant: f64,
+    iterations: usize,
+    admissibility: serde_json::Value,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Summary {
+    fretsim_version: String,
+    scenario: serde_json::Value,
+    derived: serde_json::Value,
+    normal_loading: Normal,
+    warnings: Vec<String>,
+}
+
+fn read_summary(dir: &Path) -> Summary {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn every_scenario_runs_and_writes_its_files() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let mut count = 0;
+    for entry in std::fs::read_dir(root).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "json") {
+            continue;
+        }
+        count += 1;
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("out");
+        let status = fretsim()
+            .arg("run")
+            .arg(&path)
+            .arg("--out")
+            .arg(&out)
+            .arg("--quiet")
+            .status()
+            .unwrap();
+        assert!(status.success(), "{}", path.display());
+        let s = read_summary(&out);
+        assert!(
+            (s.normal_loading.pressure_resultant - s.scenario["normal_load"].as_f64().unwrap())
+                .abs()
+                < 1e-9 * 2240.0
+        );
+        assert!(s.normal_loading.half_width > 0.0 && s.normal_loading.stick_ratio <= 1.0);
+        let csv = std::fs::read_to_string(out.join("fields/normal_loading.csv")).unwrap();
+        assert_eq!(
+            csv.lines().next().unwrap(),
+            "x_m,p_Pa,q_Pa,g_C_per_m2,sigma_xx_Pa,d_x_C_per_m2"
+        );
+        assert_eq!(csv.lines().count(), 401);
+        let _ = (&s.fretsim_version, &s.derived, &s.warnings);
+        let n = &s.normal_loading;
+        let _ = (
+            n.eccentricity,
+            n.stick_half_width,
+            n.strain_slope,
+            n.peak_pressure,
+            n.charge,
+            n.potential,
+        );
+        let _ = (n.charge_resultant, n.iterations, &n.admissibility);
+    }
+    assert!(count >= 3);
+}
+
+#[test]
+fn default_run_reports_the_paper_baseline_and_the_interpenetration_warning() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("base");
+    let output = fretsim().args(["run", "--out"]).arg(&out).output().unwrap();
+    assert!(output.status.success());
+    let s = read_summary(&out);
+    assert_eq!(s.scenario["name"], "baseline");
+    assert!(s.warnings.iter().any(|w| w.contains("Γ1")));
+}
+
+#[test]
+fn bad_input_exits_2_names_the_field_and_writes_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cases = [
+        ("{ \"name\": \"x\", ", "line"),
+        (
+            r#"{"material": {"kind": "preset", "name": "pzt4"}, "punch": {"radius": -1, "electrode": {"kind": "conducting", "charge": 6e-7}}, "friction": 0.3, "normal_load": 2000}"#,
+            "punch.radius",
+        ),
+        (
+            r#"{"material": {"kind": "preset", "name": "pzt4"}, "punch": {"radius": 0.06, "electrode": {"kind": "conducting", "charge": 6e-7}}, "friction": 0.3, "normal_load": 2000, "frictoin": 1}"#,
+            "frictoin",
+        ),
+    ];
+    for (i, (text, needle)) in cases.iter().enumerate() {
+        let file = tmp.path().join(format!("bad{i}.json"));
+        std::fs::write(&file, text).unwrap();
+        let out = tmp.path().join(format!("out{i}"));
+        let o = fretsim()
+            .arg("run")
+            .arg(&file)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "case {i}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(needle), "case {i}: {err}");
+        assert!(!out.exists(), "case {i} wrote output");
+    }
+    let o = fretsim()
+        .args(["run", "/nonexistent/scenario.json"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn rerun_replaces_stale_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("o");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("stale.csv"), "old").unwrap();
+    assert!(
+        fretsim()
+            .args(["run", "--quiet", "--out"])
+            .arg(&out)
+            .status()
+            .unwrap()
+            .success()
+    );
+    assert!(!out.join("stale.csv").exists());
+    assert!(out.join("summary.json").exists());
+}

@@ -1,0 +1,4 @@
+//! The one integration-test binary: reference solutions, scenarios and the command line.
+
+mod cli;
+mod reference;
