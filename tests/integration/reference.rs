@@ -126,3 +126,118 @@ fn reference_spence_goodman_stick_zone() {
         assert!(errors[3] < 2e-6, "{errors:?}");
     }
 }
+
+/// Zhou & Lee's half-width computed from the paper's own Appendix A.2 numbers (with the f22
+/// typo irrelevant here): eq. (21) gives `H'p = f33 x/(γ1 R)`, `γ1 = f31 f23 − f21 f33`, so
+/// `Y* = −γ1/f33` and `a² = 2PRY*/π`; A.2 has 5 digits, so 1e−4 relative.
+#[test]
+fn reference_zhou_lee_half_width_from_appendix_a2() {
+    let (f21, f23, f31, f33) = (1.7728e-11, 2.2085e-2, 2.2085e-2, -8.8307e7);
+    let gamma1 = f31 * f23 - f21 * f33;
+    let ystar = -gamma1 / f33;
+    let a_paper = (2.0 * 2000.0 * 60e-3 * ystar / std::f64::consts::PI).sqrt();
+    let model = ContactModel::new(
+        Material::Piezoelectric(PZT4),
+        60e-3,
+        0.0,
+        Electrode::ConductingCharge { charge: 6e-7 },
+    );
+    let s = solve_frictionless(&model, &Discretisation::new(32), 2000.0).unwrap();
+    assert_relative_eq!(s.half_width, a_paper, max_relative = 1e-4);
+    // Γ1 = −(f31/f33)P ≈ 5.0e−7 C/m (the formulation notes' value).
+    assert_relative_eq!(
+        model.pressure_charge(2000.0),
+        -f31 / f33 * 2000.0,
+        max_relative = 1e-4
+    );
+}
+
+/// ∫p = P and ∫g = Γ by an independent quadrature of the fields (not the series' own integrals),
+/// and the potential-controlled punch recovers the charge of the charge-controlled one.
+#[test]
+fn resultants_and_potential_control_round_trip() {
+    let charge = ContactModel::new(
+        Material::Piezoelectric(PZT4),
+        60e-3,
+        0.0,
+        Electrode::ConductingCharge { charge: 6e-7 },
+    );
+    let disc = Discretisation::new(64);
+    let s = solve_frictionless(&charge, &disc, 2000.0).unwrap();
+    let a = s.half_width;
+    // Gauss–Chebyshev of both kinds on x = a cos t, exact for these representations.
+    let n = 400;
+    let (mut ip, mut ig) = (0.0, 0.0);
+    for l in 1..=n {
+        let t = (l as f64 - 0.5) * std::f64::consts::PI / n as f64;
+        let x = a * t.cos();
+        // ∫ f dx = a ∫ f(cos t) sin t dt, midpoint in t (spectral for smooth periodic integrands).
+        ip += a * s.pressure_at(x) * t.sin() * std::f64::consts::PI / n as f64;
+        ig += a * s.charge_at(x) * t.sin() * std::f64::consts::PI / n as f64;
+    }
+    assert_relative_eq!(ip, 2000.0, max_relative = 1e-12);
+    assert_relative_eq!(ig, 6e-7, max_relative = 1e-12);
+    let phi0 = s.potential.unwrap();
+    let potential = ContactModel::new(
+        Material::Piezoelectric(PZT4),
+        60e-3,
+        0.0,
+        Electrode::ConductingPotential { potential: phi0 },
+    );
+    let sp = solve_frictionless(&potential, &disc, 2000.0).unwrap();
+    assert_relative_eq!(sp.charge, 6e-7, max_relative = 1e-12);
+    assert_relative_eq!(sp.half_width, a, max_relative = 1e-14);
+}
+
+/// Surface fields of the frictionless conducting punch against their closed forms:
+/// inside, σxx0 = −(Δ1 + Δ3 w12) p − (Δ2 + Δ3 w13) g and Dx0 = 0 (φ constant);
+/// outside, σxx0 = 0 and Dx0 = Δ4 y33 sgn(x) (Γ − kP)/(π a √(x²/a² − 1)).
+#[test]
+fn reference_surface_fields_frictionless_conducting() {
+    let gamma = 6e-7;
+    let model = ContactModel::new(
+        Material::Piezoelectric(PZT4),
+        60e-3,
+        0.0,
+        Electrode::ConductingCharge { charge: gamma },
+    );
+    let s = solve_frictionless(&model, &Discretisation::new(64), 2000.0).unwrap();
+    let (c, d) = (model.compliance, model.field_coefficients);
+    let e = c.electric.unwrap();
+    let a = s.half_width;
+    let p0 = s.pressure_at(0.0);
+    let free = gamma - model.pressure_charge(2000.0);
+    for i in 0..41 {
+        let x = a * (-1.9 + 3.8 * i as f64 / 40.0);
+        if (x.abs() - a).abs() < 0.02 * a {
+            continue;
+        }
+        let f = model.surface_point(&s, x);
+        let (sxx, dx) = if x.abs() < a {
+            (
+                -(d.delta1 + d.delta3 * c.w12) * f.pressure
+                    - (d.delta2 + d.delta3 * e.w13) * f.charge,
+                0.0,
+            )
+        } else {
+            let r = x / a;
+            (
+                0.0,
+                d.delta4 * e.y33 * r.signum() * free
+                    / (std::f64::consts::PI * a * (r * r - 1.0).sqrt()),
+            )
+        };
+        assert!(
+            (f.sigma_xx - sxx).abs() < 1e-10 * p0,
+            "σxx at x/a = {}",
+            x / a
+        );
+        let dscale = d.delta4 * e.y33.abs() * free.abs() / a;
+        assert!(
+            (f.d_x - dx).abs() < 1e-10 * dscale,
+            "Dx at x/a = {}: {} vs {dx}",
+            x / a,
+            f.d_x
+        );
+    }
+}
