@@ -96,11 +96,8 @@ pub enum RawElectrode {
         #[serde(default)]
         potential: Option<f64>,
     },
-    /// Insulating punch with charge Γ (C/m) distributed like the pressure.
-    Insulating {
-        /// Γ (C/m).
-        charge: f64,
-    },
+    /// Insulating punch: no surface charge on the contact (`g ≡ 0`).
+    Insulating {},
 }
 
 /// Numerical settings.
@@ -316,17 +313,7 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
                 None
             }
         },
-        (RawElectrode::Insulating { charge }, _) => {
-            if charge.is_finite() {
-                Some(Electrode::Insulating { charge: *charge })
-            } else {
-                issues.push(Issue::new(
-                    "punch.electrode.charge",
-                    format!("{charge} C/m is invalid; it must be finite"),
-                ));
-                None
-            }
-        }
+        (RawElectrode::Insulating {}, _) => Some(Electrode::Insulating),
     };
     match (material, electrode, issues.is_empty()) {
         (Some(material), Some(electrode), true) => {

@@ -23,7 +23,7 @@ pub fn solve_frictionless(
     let a = pressure.half_width;
     let (charge, potential) = match model.electrode {
         Electrode::None => (0.0, None),
-        Electrode::Insulating { charge } => (charge, None),
+        Electrode::Insulating => (0.0, None),
         Electrode::ConductingCharge { charge } => (
             charge,
             Some(contact_potential(model, a, normal_load, charge, 0.0)),

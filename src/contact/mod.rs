@@ -18,7 +18,12 @@
 //! - conducting punch (φ constant on the contact): `χ = k = −y23/y33` and, from (C),
 //!   `y33 H'w = −w13 q`, `∫w = Γ − kP` (seed eqs. 23, 26–29: `g1 = k p` is the part carried by
 //!   the pressure, `w = g2` the part held by the constant potential);
-//! - insulating punch: `w = 0`, `χ = Γ/P` (charge distributed like the pressure);
+//! - insulating punch: `g ≡ 0` (`χ = 0`, `w = 0`). The seed paper says the conducting punch,
+//!   unlike the insulating one, puts charge on the contact surface, and its trends confirm this
+//!   reading: with `g ≡ 0` we get the smaller stick zone and the larger |C| it reports for the
+//!   insulating punch at every η, while the alternative `g = (Γ/P) p` gives the opposite order
+//!   (PZT-4, R = 60 mm, P = 2000 N/m, η = 0.3: b/a = 0.954 conducting, 0.343 for `g ≡ 0`,
+//!   0.991 for `g = (Γ/P)p`). Γ therefore has no effect under an insulating punch;
 //! - elastic half-plane: `χ = 0`, `w = 0`.
 //!
 //! Eliminating g from (B) gives the pressure equation (seed eqs. 21/46):
@@ -75,11 +80,8 @@ pub enum Electrode {
         /// φ0 (V).
         potential: f64,
     },
-    /// Insulating punch carrying Γ (C/m), distributed like the pressure, `g = (Γ/P) p`.
-    Insulating {
-        /// Γ (C/m).
-        charge: f64,
-    },
+    /// Insulating punch: no charge on the contact surface, `g ≡ 0` (module docs).
+    Insulating,
 }
 
 /// Whether the shear traction is fed back into the pressure equation.
@@ -151,7 +153,7 @@ impl ContactModel {
     }
 
     /// χ and the conducting flag at normal load P.
-    pub fn charge_split(&self, normal_load: f64) -> ChargeSplit {
+    pub fn charge_split(&self, _normal_load: f64) -> ChargeSplit {
         match self.electrode {
             Electrode::None => ChargeSplit {
                 ratio: 0.0,
@@ -163,8 +165,8 @@ impl ContactModel {
                     conducting: true,
                 }
             }
-            Electrode::Insulating { charge } => ChargeSplit {
-                ratio: charge / normal_load,
+            Electrode::Insulating => ChargeSplit {
+                ratio: 0.0,
                 conducting: false,
             },
         }

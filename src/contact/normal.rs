@@ -92,7 +92,7 @@ fn electric_resultants(
 ) -> (f64, Option<f64>) {
     match model.electrode {
         Electrode::None => (0.0, None),
-        Electrode::Insulating { charge } => (charge, None),
+        Electrode::Insulating => (0.0, None),
         Electrode::ConductingCharge { charge } => (
             charge,
             Some(contact_potential(model, a, normal_load, charge, j_q)),
@@ -168,11 +168,38 @@ fn stick_for(
 }
 
 /// Solve normal loading to `normal_load` with the model's friction and electrode.
+///
+/// The slip zones are first assumed to carry outward friction (`q = +ηp sign x`, the
+/// half-plane drawn inward); if no state of that form exists, inward friction is tried.
 pub fn solve_normal(
     model: &ContactModel,
     disc: &Discretisation,
     normal_load: f64,
     options: NormalOptions,
+) -> Result<NormalLoading, SolveFailure> {
+    match solve_normal_directed(model, disc, normal_load, options, 1.0) {
+        Err(SolveFailure::NoAdmissibleState { reason }) => solve_normal_directed(
+            model,
+            disc,
+            normal_load,
+            options,
+            -1.0,
+        )
+        .map_err(|second| SolveFailure::NoAdmissibleState {
+            reason: format!(
+                "{reason} with outward friction in the slip zones; with inward friction: {second}"
+            ),
+        }),
+        other => other,
+    }
+}
+
+fn solve_normal_directed(
+    model: &ContactModel,
+    disc: &Discretisation,
+    normal_load: f64,
+    options: NormalOptions,
+    outward: f64,
 ) -> Result<NormalLoading, SolveFailure> {
     let first = super::frictionless::solve_frictionless(model, disc, normal_load)?;
     if model.friction <= 0.0 {
@@ -190,8 +217,8 @@ pub fn solve_normal(
     let mut state = first;
     state.traction = Traction {
         friction: eta,
-        left_sign: -1.0,
-        right_sign: 1.0,
+        left_sign: -outward,
+        right_sign: outward,
         stick: None,
     };
     let mut b = 0.5 * state.half_width;
@@ -397,7 +424,7 @@ pub fn assess_normal_state(
             }
         }
     }
-    // Slip direction in the right slip zone: 2∫₀ˣ ε − x ε(x) ≤ 0.
+    // Slip direction in the right slip zone: sign(q)·(2∫₀ˣ ε − x ε(x)) ≤ 0.
     let strain = |x: f64| state.strain_at(model, x);
     let mut integral = 0.5 * slope * b * b;
     let n = 400;
@@ -410,7 +437,7 @@ pub fn assess_normal_state(
         integral += 0.5 * (e + prev_e) * (x - prev_x);
         prev_x = x;
         prev_e = e;
-        let rate = (2.0 * integral - x * e) / scale;
+        let rate = state.traction.right_sign * (2.0 * integral - x * e) / scale;
         if rate > out.slip_reversal {
             out.slip_reversal = rate;
             out.slip_reversal_at = x;
@@ -442,8 +469,7 @@ fn check_normal_state(
     }
     if adm.slip_reversal > tol {
         return Err(SolveFailure::Inadmissible {
-            check: "slip in the right slip zone must run inward against the outward friction"
-                .into(),
+            check: "slip in the right slip zone must run against the friction".into(),
             value: adm.slip_reversal,
             x: adm.slip_reversal_at,
         });

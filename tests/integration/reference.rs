@@ -241,3 +241,67 @@ fn reference_surface_fields_frictionless_conducting() {
         );
     }
 }
+
+/// The trends the seed paper states for PZT-4 (Figures 8–9): b/a rises with η and is larger for
+/// the conducting punch; |C| falls with η and is larger for the insulating punch.
+#[test]
+fn paper_trends_figures_8_and_9() {
+    use fretsim::contact::normal::{NormalOptions, solve_normal};
+    let disc = Discretisation::new(32);
+    let solve = |electrode, eta| {
+        let model = ContactModel::new(Material::Piezoelectric(PZT4), 60e-3, eta, electrode);
+        let s = solve_normal(&model, &disc, 2000.0, NormalOptions::default()).unwrap();
+        (
+            s.stick_half_width / s.state.half_width,
+            s.strain_slope.abs(),
+        )
+    };
+    let mut previous: Option<((f64, f64), (f64, f64))> = None;
+    for eta in [0.2, 0.3, 0.5, 0.8] {
+        let cond = solve(Electrode::ConductingCharge { charge: 6e-7 }, eta);
+        let ins = solve(Electrode::Insulating, eta);
+        assert!(
+            cond.0 > ins.0,
+            "η = {eta}: conducting b/a {} ≤ insulating {}",
+            cond.0,
+            ins.0
+        );
+        assert!(
+            ins.1 > cond.1,
+            "η = {eta}: insulating |C| {} ≤ conducting {}",
+            ins.1,
+            cond.1
+        );
+        if let Some((pc, pi)) = previous {
+            assert!(cond.0 > pc.0 && ins.0 > pi.0, "b/a must rise with η");
+            assert!(cond.1 < pc.1 && ins.1 < pi.1, "|C| must fall with η");
+        }
+        previous = Some((cond, ins));
+    }
+}
+
+/// Below Γ1 = kP the constant-potential charge Γ − Γ1 is negative and the edge strain it
+/// induces drives the half-plane outward under the punch edges: the admissible state has
+/// *inward* friction in both slip zones (outward friction has no stick zone with a smooth end).
+#[test]
+fn electric_load_across_gamma1_switches_the_slip_direction() {
+    use fretsim::contact::normal::{NormalOptions, solve_normal};
+    let disc = Discretisation::new(32);
+    for (gamma, sign) in [(0.0, -1.0), (3e-7, -1.0), (6e-7, 1.0), (9e-7, 1.0)] {
+        let model = ContactModel::new(
+            Material::Piezoelectric(PZT4),
+            60e-3,
+            0.3,
+            Electrode::ConductingCharge { charge: gamma },
+        );
+        let s = solve_normal(&model, &disc, 2000.0, NormalOptions::default()).unwrap();
+        assert!(
+            (s.state.traction.right_sign - sign).abs() < 1e-12,
+            "Γ = {gamma:e}"
+        );
+        assert!(
+            s.admissibility.stick_excess <= 0.0 && s.admissibility.slip_reversal <= 0.0,
+            "Γ = {gamma:e}"
+        );
+    }
+}
