@@ -1,4 +1,51 @@
-//! fretsim (crate docs to be completed).
+//! # fretsim
+//!
+//! Fretting contact of a rigid cylindrical punch (radius R) on a transversely isotropic
+//! piezoelectric half-plane (poled normal to the surface) or an isotropic elastic half-plane,
+//! in plane strain, after the seed paper (fretting contact of a piezoelectric half-plane under a
+//! rigid conducting cylindrical punch; equation numbers below are the paper's).
+//!
+//! ## The model
+//! The surface response of the half-plane to a pressure p, shear traction q and surface charge g
+//! on the contact `[c − a, c + a]` is, with `H'f(x) = (1/π)⨍ f(s)/(s − x) ds`,
+//!
+//! ```text
+//! ∂ux/∂x = −w12 p − w13 g + y11 H'q      (seed eq. 11)
+//! ∂uz/∂x =  w12 q + y22 H'p + y23 H'g    (seed eq. 12)
+//! ∂φ/∂x  =  w13 q + y23 H'p + y33 H'g    (seed eq. 13)
+//! ```
+//!
+//! with coefficients computed from the constants ([`halfplane`]). The rigid punch imposes
+//! `∂uz/∂x = −x/R`, a conducting punch `∂φ/∂x = 0`; Coulomb friction `|q| ≤ ηp` holds with
+//! equality in the slip zones and the stick zones keep the strain `∂ux/∂x` they had when they
+//! stuck. The resulting Cauchy singular integral equations are solved by Gauss–Chebyshev
+//! collocation ([`quadrature`]) with the contact geometry (a, c, stick-zone ends) fixed by the
+//! consistency conditions of bounded solutions ([`contact`]).
+//!
+//! ## Symbols
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | P, Q | normal and tangential line loads | N/m |
+//! | Γ, φ0 | resultant charge on the punch, its potential | C/m, V |
+//! | η | friction coefficient | – |
+//! | a, c | contact half-width and centre (eccentricity e = −c) | m |
+//! | b | stick-zone half-width in normal loading | m |
+//! | C | slope of the locked-in strain `∂ux/∂x = C|x|` | 1/m |
+//! | p, q, g | pressure, shear traction on the half-plane, surface charge (`Dz = −g`) | Pa, Pa, C/m² |
+//! | σxx0, Dx0 | surface in-plane stress and electric displacement | Pa, C/m² |
+//! | Y*, κ, k | pressure compliance, shear–pressure coupling, charge per force | 1/Pa, 1/Pa, C/N |
+//! | d | datum distance of the regularised log kernel | m |
+//!
+//! ## Modules
+//! - [`material`]: constants, presets, validation.
+//! - [`halfplane`]: surface compliance (extended Stroh formalism), the paper's f_ij, Δ1…Δ4.
+//! - [`quadrature`]: Gauss–Chebyshev grids, factored collocation matrices, Chebyshev series.
+//! - [`contact`]: the contact model and state; [`contact::frictionless`] (Hertz, Zhou & Lee),
+//!   [`contact::normal`] (Spence's self-similar partial slip), [`contact::pressure`] (shared
+//!   pressure and charge sub-problems).
+//! - [`analytical`]: closed-form oracles.
+//! - [`scenario`], [`app`], [`output`], [`cli`], [`error`]: input, orchestration, files, arguments,
+//!   errors. The numerical modules do no I/O.
 #![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
