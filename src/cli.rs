@@ -20,7 +20,7 @@ pub enum Command {
     Run {
         /// Scenario file (JSON).
         scenario: Option<PathBuf>,
-        /// Output folder (default: output/<scenario name>).
+        /// Output folder (default: `output/<scenario name>`).
         #[arg(long)]
         out: Option<PathBuf>,
         /// No progress output.

@@ -69,8 +69,9 @@ pub struct NormalOptions {
     pub tolerance: f64,
     /// Maximum block iterations.
     pub max_iterations: usize,
-    /// Allowed violation of `|q| ≤ ηp` (relative to `η p(centre)`) and of the slip direction,
-    /// the size of the discretisation error near the stick ends.
+    /// Allowed violation of `|q| ≤ ηp` (relative to `η p(centre)`) and of the slip direction
+    /// (relative to `|C| b²`). Every converged state measured so far (Spence, aluminium, PZT-4
+    /// at η = 0.1–0.8, Γ = 0–9e−7, M = 16–256) has both ≤ 0; 1e−3 leaves room for coarse M.
     pub admissibility: f64,
 }
 
@@ -79,7 +80,7 @@ impl Default for NormalOptions {
         Self {
             tolerance: 1e-11,
             max_iterations: 200,
-            admissibility: 1e-2,
+            admissibility: 1e-3,
         }
     }
 }
