@@ -7,9 +7,9 @@ use crate::error::SolveFailure;
 use crate::quadrature::UnboundedSeries;
 
 use super::pressure::{
-    Discretisation, charge_for_potential, contact_potential, solve_potential_charge, solve_pressure,
+    Discretisation, electric_resultants, solve_potential_charge, solve_pressure,
 };
-use super::{ContactModel, ContactState, Electrode, Traction};
+use super::{ContactModel, ContactState, Traction};
 
 /// Solve frictionless normal contact under load P (N/m) with the model's electrode.
 pub fn solve_frictionless(
@@ -21,18 +21,7 @@ pub fn solve_frictionless(
     let zero = |_: f64| 0.0;
     let pressure = solve_pressure(model, disc, split, normal_load, &zero, (f64::NAN, 0.0))?;
     let a = pressure.half_width;
-    let (charge, potential) = match model.electrode {
-        Electrode::None => (0.0, None),
-        Electrode::Insulating => (0.0, None),
-        Electrode::ConductingCharge { charge } => (
-            charge,
-            Some(contact_potential(model, a, normal_load, charge, 0.0)),
-        ),
-        Electrode::ConductingPotential { potential } => (
-            charge_for_potential(model, a, normal_load, potential, 0.0),
-            Some(potential),
-        ),
-    };
+    let (charge, potential) = electric_resultants(model, a, normal_load, 0.0);
     let potential_charge = if split.conducting {
         let free = charge - model.pressure_charge(normal_load);
         solve_potential_charge(model, disc, a, pressure.centre, free, &zero)
@@ -56,19 +45,10 @@ pub fn solve_frictionless(
             stick: None,
         },
     };
-    for (name, v) in [
-        ("contact half-width", state.half_width),
-        ("contact centre", state.centre),
-    ] {
-        if !v.is_finite() {
-            return Err(SolveFailure::NonFinite {
-                field: if name.ends_with("width") {
-                    "contact half-width"
-                } else {
-                    "contact centre"
-                },
-            });
-        }
+    if !(state.half_width.is_finite() && state.centre.is_finite()) {
+        return Err(SolveFailure::NonFinite {
+            field: "contact half-width or centre",
+        });
     }
     if state
         .pressure

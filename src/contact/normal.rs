@@ -41,9 +41,9 @@ use crate::error::SolveFailure;
 use crate::quadrature::{BoundedSeries, UnboundedSeries};
 
 use super::pressure::{
-    Discretisation, charge_for_potential, contact_potential, solve_potential_charge, solve_pressure,
+    Discretisation, electric_resultants, solve_potential_charge, solve_pressure,
 };
-use super::{ContactModel, ContactState, Electrode, StickZone, Traction, graded_rule};
+use super::{ContactModel, ContactState, StickZone, Traction, graded_rule};
 
 /// Result of the normal-loading solve.
 #[derive(Debug, Clone, Serialize)]
@@ -82,26 +82,6 @@ impl Default for NormalOptions {
             max_iterations: 200,
             admissibility: 1e-3,
         }
-    }
-}
-
-fn electric_resultants(
-    model: &ContactModel,
-    a: f64,
-    normal_load: f64,
-    j_q: f64,
-) -> (f64, Option<f64>) {
-    match model.electrode {
-        Electrode::None => (0.0, None),
-        Electrode::Insulating => (0.0, None),
-        Electrode::ConductingCharge { charge } => (
-            charge,
-            Some(contact_potential(model, a, normal_load, charge, j_q)),
-        ),
-        Electrode::ConductingPotential { potential } => (
-            charge_for_potential(model, a, normal_load, potential, j_q),
-            Some(potential),
-        ),
     }
 }
 
@@ -318,8 +298,8 @@ fn find_stick_zone(
     // Bracket: scan outward from the guess on a geometric grid in (0, a).
     let hi_limit = a * (1.0 - 1e-9);
     let lo_limit = a * 1e-6;
-    let mut x0 = guess.clamp(lo_limit, hi_limit);
-    let mut f0 = f(x0).3;
+    let x0 = guess.clamp(lo_limit, hi_limit);
+    let f0 = f(x0).3;
     let mut bracket = None;
     for k in 1..60 {
         let step = 0.02 * a * 1.3f64.powi(k);
@@ -341,8 +321,6 @@ fn find_stick_zone(
         if x0 + step >= hi_limit && x0 - step <= lo_limit {
             break;
         }
-        let _ = &mut x0;
-        let _ = &mut f0;
     }
     let Some((mut xl, mut fl, mut xr, mut fr)) = bracket else {
         // No sign change: the √ coefficient never vanishes. Full stick (b → a) when it keeps

@@ -189,3 +189,30 @@ pub fn charge_for_potential(
     let log = (2.0 * model.reference_distance / half_width).ln();
     (std::f64::consts::PI * potential + e.w13 * j_q - log * e.y23 * normal_load) / (log * e.y33)
 }
+
+/// Γ and φ0 for the model's electrode at half-width a, given the arcsine moment `J_q` of q.
+pub fn electric_resultants(
+    model: &ContactModel,
+    half_width: f64,
+    normal_load: f64,
+    j_q: f64,
+) -> (f64, Option<f64>) {
+    use super::Electrode;
+    match model.electrode {
+        Electrode::None | Electrode::Insulating => (0.0, None),
+        Electrode::ConductingCharge { charge } => (
+            charge,
+            Some(contact_potential(
+                model,
+                half_width,
+                normal_load,
+                charge,
+                j_q,
+            )),
+        ),
+        Electrode::ConductingPotential { potential } => (
+            charge_for_potential(model, half_width, normal_load, potential, j_q),
+            Some(potential),
+        ),
+    }
+}
