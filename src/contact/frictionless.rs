@@ -19,7 +19,15 @@ pub fn solve_frictionless(
 ) -> Result<ContactState, SolveFailure> {
     let split = model.charge_split(normal_load);
     let zero = |_: f64| 0.0;
-    let pressure = solve_pressure(model, disc, split, normal_load, &zero, (f64::NAN, 0.0))?;
+    let pressure = solve_pressure(
+        model,
+        disc,
+        split,
+        normal_load,
+        &zero,
+        (f64::NAN, 0.0),
+        true,
+    )?;
     let a = pressure.half_width;
     let (charge, potential) = electric_resultants(model, a, normal_load, 0.0);
     let potential_charge = if split.conducting {

@@ -226,6 +226,7 @@ fn solve_normal_directed(
             normal_load,
             &q,
             (state.half_width, state.centre),
+            true,
         )?;
         state.half_width = pressure.half_width;
         state.centre = pressure.centre;
@@ -260,8 +261,19 @@ fn solve_normal_directed(
                 correction,
                 kink,
             });
-            let admissibility =
-                check_normal_state(model, &state, slope_fin, options.admissibility)?;
+            let admissibility = check_normal_state(model, &state, slope_fin, options.admissibility)
+                .map_err(|failure| {
+                    if b_fin >= state.half_width {
+                        SolveFailure::NoAdmissibleState {
+                            reason: format!(
+                                "the stick-zone end condition ψ̃(±1) = 0 has no root for 0 < b < a and full stick is \
+                                 inadmissible ({failure})"
+                            ),
+                        }
+                    } else {
+                        failure
+                    }
+                })?;
             return Ok(NormalLoading {
                 admissibility,
                 state,
@@ -297,7 +309,7 @@ fn find_stick_zone(
     let f = |b: f64| stick_for(model, disc, state, b);
     // Bracket: scan outward from the guess on a geometric grid in (0, a).
     let hi_limit = a * (1.0 - 1e-9);
-    let lo_limit = a * 1e-6;
+    let lo_limit = a * 1e-12;
     let x0 = guess.clamp(lo_limit, hi_limit);
     let f0 = f(x0).3;
     let mut bracket = None;
@@ -322,14 +334,18 @@ fn find_stick_zone(
             break;
         }
     }
+    if bracket.is_none() {
+        // The lower end of the range: a stick zone below 1e−12 a is full slip for every purpose.
+        let f_lo = f(lo_limit).3;
+        if f_lo.signum() != f0.signum() {
+            bracket = Some((lo_limit, f_lo, x0, f0));
+        }
+    }
     let Some((mut xl, mut fl, mut xr, mut fr)) = bracket else {
-        // No sign change: the √ coefficient never vanishes. Full stick (b → a) when it keeps
-        // the admissible sign at b = a.
-        return Err(SolveFailure::NoAdmissibleState {
-            reason: format!(
-                "the stick-zone end condition ψ̃(±1) = 0 has no root for 0 < b < a (a = {a:.6e} m)"
-            ),
-        });
+        // No root in (0, a): the candidate is full stick, b = a, whose traction may keep a √
+        // term at the contact ends (admissible when |q| ≤ ηp there); the caller checks it.
+        let (slope, series, kink, _) = f(a);
+        return Ok((a, slope, series, kink));
     };
     // Illinois (regula falsi) iteration.
     let mut side = 0;

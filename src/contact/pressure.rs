@@ -70,7 +70,9 @@ pub struct PressureSolution {
 }
 
 /// Solve the pressure for the shear traction `q(x)` (material coordinates), starting from
-/// the guess `(a, c)`.
+/// the guess `(a, c)`. With `symmetric` the centre is held at c = 0 (normal loading, where
+/// the mirror symmetry of material and load centres the contact; sampling a traction that
+/// changes sign across a tiny stick zone would otherwise make the c-update discontinuous).
 pub fn solve_pressure(
     model: &ContactModel,
     disc: &Discretisation,
@@ -78,6 +80,7 @@ pub fn solve_pressure(
     normal_load: f64,
     traction: &dyn Fn(f64) -> f64,
     guess: (f64, f64),
+    symmetric: bool,
 ) -> Result<PressureSolution, SolveFailure> {
     let m = disc.nodes();
     let ystar = model.pressure_compliance(split);
@@ -93,6 +96,7 @@ pub fn solve_pressure(
     let mut psi_q = vec![0.0; m];
     let coupled = kappa != 0.0;
     let max_iter = 100;
+    let mut last_change = f64::NAN;
     for iter in 1..=max_iter {
         let (lambda, iq) = if coupled {
             for (r, &t) in rhs.iter_mut().zip(&disc.bounded.collocation) {
@@ -103,7 +107,7 @@ pub fn solve_pressure(
         } else {
             (0.0, 0.0)
         };
-        let c_new = lambda / scale;
+        let c_new = if symmetric { 0.0 } else { lambda / scale };
         let a_new = (-iq + (iq * iq + 4.0 * i1 * normal_load).sqrt()) / (2.0 * i1);
         if !(a_new.is_finite() && c_new.is_finite()) {
             return Err(SolveFailure::NonFinite {
@@ -111,9 +115,10 @@ pub fn solve_pressure(
             });
         }
         let change = ((a_new - a).abs() + (c_new - c).abs()) / a_new;
+        last_change = change;
         a = a_new;
         c = c_new;
-        if !coupled || change < 1e-14 {
+        if !coupled || change < 1e-13 {
             let psi: Vec<f64> = disc
                 .unit_psi
                 .iter()
@@ -131,7 +136,7 @@ pub fn solve_pressure(
     Err(SolveFailure::NoConvergence {
         what: "contact half-width and centre",
         iterations: max_iter,
-        residual: f64::NAN,
+        residual: last_change,
     })
 }
 

@@ -305,3 +305,41 @@ fn electric_load_across_gamma1_switches_the_slip_direction() {
         );
     }
 }
+
+/// η → 0 tends to the frictionless solution (the shift of a is linear in η) and growing η
+/// closes the slip zones (b → a). Measured (PZT-4 baseline, M = 64): (a − a0)/a0 = −8.7e−4 at
+/// η = 0.02 and −2.2e−3 at η = 0.05; 1 − b/a = 1.6e−2, 5.3e−3, 2.0e−3 at η = 0.5, 1, 2.
+#[test]
+fn friction_limits_tend_to_frictionless_and_to_full_stick() {
+    use fretsim::contact::normal::{NormalOptions, solve_normal};
+    let disc = Discretisation::new(64);
+    let model = |eta| {
+        ContactModel::new(
+            Material::Piezoelectric(PZT4),
+            60e-3,
+            eta,
+            Electrode::ConductingCharge { charge: 6e-7 },
+        )
+    };
+    let a0 = solve_frictionless(&model(0.0), &disc, 2000.0)
+        .unwrap()
+        .half_width;
+    let shift = |eta| {
+        let s = solve_normal(&model(eta), &disc, 2000.0, NormalOptions::default()).unwrap();
+        (s.state.half_width / a0 - 1.0).abs()
+    };
+    let (s2, s5) = (shift(0.02), shift(0.05));
+    assert!(s2 < s5 && s5 < 5e-3, "{s2:e} {s5:e}");
+    assert!(
+        (s5 / s2 - 2.5).abs() < 0.5,
+        "shift not ~linear in η: {s2:e}, {s5:e}"
+    );
+    let mut previous = 1.0;
+    for eta in [0.5, 1.0, 2.0] {
+        let s = solve_normal(&model(eta), &disc, 2000.0, NormalOptions::default()).unwrap();
+        let gap = 1.0 - s.stick_half_width / s.state.half_width;
+        assert!(gap < previous && gap > 0.0, "η = {eta}: 1 − b/a = {gap}");
+        previous = gap;
+    }
+    assert!(previous < 3e-3);
+}
