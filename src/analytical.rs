@@ -116,3 +116,66 @@ pub fn spence_stick_ratio(beta_over_eta: f64) -> f64 {
 pub fn spence_strain_slope(friction: f64, radius: f64, stick_ratio: f64) -> f64 {
     -std::f64::consts::PI * friction / (2.0 * radius * stick_ratio * elliptic_k(stick_ratio))
 }
+
+/// Cattaneo–Mindlin and Mindlin–Deresiewicz line contact in the uncoupled limit (β = 0):
+/// Hertzian pressure `p0√(1 − x²/a²)`, friction η, normal load P.
+///
+/// - Loading from 0 to Q: stick zone `|x| ≤ c`, `c/a = √(1 − |Q|/(ηP))`,
+///   `q = sign(Q) η p0 [√(1 − x²/a²) − (c/a)√(1 − x²/c²)]` (inner term only for |x| < c).
+/// - Unloading from Q* to Q (Masing): `q = q_load(Q*) − 2 q_load((Q* − Q)/2)`, stick zone
+///   `c'/a = √(1 − |Q* − Q|/(2ηP))`.
+#[derive(Debug, Clone, Copy)]
+pub struct CattaneoMindlin {
+    /// Contact half-width a (m).
+    pub half_width: f64,
+    /// Peak pressure p0 (Pa).
+    pub peak_pressure: f64,
+    /// Friction coefficient η.
+    pub friction: f64,
+    /// Normal load P (N/m).
+    pub normal_load: f64,
+}
+
+impl CattaneoMindlin {
+    /// From a Hertz solution.
+    pub fn new(hertz: Hertz, friction: f64, normal_load: f64) -> Self {
+        Self {
+            half_width: hertz.half_width,
+            peak_pressure: hertz.peak_pressure,
+            friction,
+            normal_load,
+        }
+    }
+
+    /// c/a after loading from 0 to Q.
+    pub fn stick_ratio(&self, q: f64) -> f64 {
+        (1.0 - q.abs() / (self.friction * self.normal_load))
+            .max(0.0)
+            .sqrt()
+    }
+
+    /// Traction after loading from 0 to Q (Pa).
+    pub fn loading_traction(&self, q: f64, x: f64) -> f64 {
+        let r = x / self.half_width;
+        if r.abs() >= 1.0 {
+            return 0.0;
+        }
+        let c = self.stick_ratio(q);
+        let inner = if r.abs() < c {
+            c * (1.0 - (r / c).powi(2)).sqrt()
+        } else {
+            0.0
+        };
+        q.signum() * self.friction * self.peak_pressure * ((1.0 - r * r).sqrt() - inner)
+    }
+
+    /// c'/a after unloading from Q* to Q.
+    pub fn unloading_stick_ratio(&self, q_star: f64, q: f64) -> f64 {
+        self.stick_ratio((q_star - q) / 2.0)
+    }
+
+    /// Traction after unloading from Q* to Q (Pa).
+    pub fn unloading_traction(&self, q_star: f64, q: f64, x: f64) -> f64 {
+        self.loading_traction(q_star, x) - 2.0 * self.loading_traction((q_star - q) / 2.0, x)
+    }
+}

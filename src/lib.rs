@@ -55,6 +55,7 @@ pub mod cli;
 pub mod contact;
 pub mod error;
 pub mod halfplane;
+pub mod history;
 pub mod material;
 pub mod output;
 pub mod quadrature;

@@ -55,8 +55,11 @@
 //! valid on and off the contact (off it p = q = g = 0 and only the Cauchy terms remain).
 
 pub mod frictionless;
+pub mod memory;
 pub mod normal;
 pub mod pressure;
+pub mod roots;
+pub mod tangential;
 
 use serde::Serialize;
 
@@ -223,6 +226,10 @@ pub struct StickZone {
     /// Amplitude A of the kink part `A·k(u)` of q̃ (Pa), see [`kink_density`]; non-zero only
     /// for the normal-loading state, whose memory `C|x|` has a kink at the centre.
     pub kink: f64,
+    /// Correction inherited from the state that began the phase (its own zone lies inside
+    /// this one); it carries the exact square-root structure of the memory at old stick ends.
+    #[serde(skip)]
+    pub inherited: Option<std::sync::Arc<StickZone>>,
 }
 
 /// `k(u) = −(2u/π) artanh √(1 − u²)`: the bounded solution of
@@ -249,16 +256,63 @@ pub fn kink_cauchy(u: f64) -> f64 {
 }
 
 impl StickZone {
-    /// q̃ at x (Pa).
-    pub fn correction_at(&self, x: f64) -> f64 {
-        let u = (x - self.mid()) / self.half();
-        self.correction.density(u) + self.kink * kink_density(u)
+    /// A zone with its own correction only.
+    pub fn new(lo: f64, hi: f64, correction: BoundedSeries, kink: f64) -> Self {
+        Self {
+            lo,
+            hi,
+            correction,
+            kink,
+            inherited: None,
+        }
     }
 
-    /// `H'q̃(x)` (Pa).
+    /// q̃ at x (Pa), including the inherited chain.
+    pub fn correction_at(&self, x: f64) -> f64 {
+        let u = (x - self.mid()) / self.half();
+        let own = self.correction.density(u) + self.kink * kink_density(u);
+        own + self.inherited.as_ref().map_or(0.0, |z| z.correction_at(x))
+    }
+
+    /// `H'q̃(x)` (Pa), including the inherited chain.
     pub fn correction_cauchy(&self, x: f64) -> f64 {
         let u = (x - self.mid()) / self.half();
-        self.correction.cauchy(u) + self.kink * kink_cauchy(u)
+        let own = self.correction.cauchy(u) + self.kink * kink_cauchy(u);
+        own + self
+            .inherited
+            .as_ref()
+            .map_or(0.0, |z| z.correction_cauchy(x))
+    }
+
+    /// `∫ q̃ dx` (N/m), including the inherited chain (the kink part is odd).
+    pub fn correction_integral(&self) -> f64 {
+        self.half() * self.correction.integral()
+            + self
+                .inherited
+                .as_ref()
+                .map_or(0.0, |z| z.correction_integral())
+    }
+
+    /// The outermost zone of this chain that lies inside `[lo, hi]`.
+    pub fn contained_in(
+        self: &std::sync::Arc<Self>,
+        lo: f64,
+        hi: f64,
+    ) -> Option<std::sync::Arc<StickZone>> {
+        let slack = 1e-12 * (hi - lo);
+        let mut zone = Some(self.clone());
+        while let Some(z) = zone {
+            if z.lo >= lo - slack && z.hi <= hi + slack {
+                return Some(z);
+            }
+            zone = z.inherited.clone();
+        }
+        None
+    }
+
+    /// Number of zones in the chain.
+    pub fn chain_len(&self) -> usize {
+        1 + self.inherited.as_ref().map_or(0, |z| z.chain_len())
     }
 }
 

@@ -120,12 +120,7 @@ fn stick_for(
     let y11 = model.compliance.y11;
     let eta = model.friction;
     let mut state = trial.clone();
-    state.traction.stick = Some(StickZone {
-        lo: -b,
-        hi: b,
-        correction: BoundedSeries::default(),
-        kink: 0.0,
-    });
+    state.traction.stick = Some(StickZone::new(-b, b, BoundedSeries::default(), 0.0));
     let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
     let local = model.local_pressure_strain(state.split);
     let rhs: Vec<f64> = disc
@@ -158,20 +153,37 @@ pub fn solve_normal(
     normal_load: f64,
     options: NormalOptions,
 ) -> Result<NormalLoading, SolveFailure> {
+    let split = model.charge_split(normal_load);
+    if model.friction > 0.0
+        && !split.conducting
+        && model.local_pressure_strain(split).abs() <= 1e-14 * model.compliance.y11
+    {
+        // Uncoupled (β = 0): the frictionless pressure draws no point sideways, so nothing
+        // slips and no traction arises; the whole contact sticks with zero locked-in strain.
+        let mut state = super::frictionless::solve_frictionless(model, disc, normal_load)?;
+        let a = state.half_width;
+        state.traction = Traction {
+            friction: model.friction,
+            left_sign: 0.0,
+            right_sign: 0.0,
+            stick: Some(StickZone::new(-a, a, BoundedSeries::default(), 0.0)),
+        };
+        return Ok(NormalLoading {
+            state,
+            stick_half_width: a,
+            strain_slope: 0.0,
+            iterations: 0,
+            residual: 0.0,
+            admissibility: Admissibility::default(),
+        });
+    }
     match solve_normal_directed(model, disc, normal_load, options, 1.0) {
-        Err(SolveFailure::NoAdmissibleState { reason }) => solve_normal_directed(
-            model,
-            disc,
-            normal_load,
-            options,
-            -1.0,
-        )
-        .map_err(|second| SolveFailure::NoAdmissibleState {
-            reason: format!(
-                "{reason} with outward friction in the slip zones; with inward friction: {second}"
-            ),
+        Ok(result) => Ok(result),
+        Err(first) => solve_normal_directed(model, disc, normal_load, options, -1.0).map_err(|second| {
+            SolveFailure::NoAdmissibleState {
+                reason: format!("with outward friction in the slip zones: {first}; with inward friction: {second}"),
+            }
         }),
-        other => other,
     }
 }
 
@@ -210,12 +222,7 @@ fn solve_normal_directed(
         // 1. Stick zone for the current p, w: root of ψ̃(1)(b) on (0, a).
         let (b_new, slope_new, correction, kink) = find_stick_zone(model, disc, &state, b)?;
         let previous = state.clone();
-        state.traction.stick = Some(StickZone {
-            lo: -b_new,
-            hi: b_new,
-            correction,
-            kink,
-        });
+        state.traction.stick = Some(StickZone::new(-b_new, b_new, correction, kink));
         // 2. Pressure and charge for the new traction (lagged inside the sub-solvers).
         let lagged = previous_with_stick(&previous, &state);
         let q = |x: f64| lagged.traction_at(x);
@@ -255,12 +262,7 @@ fn solve_normal_directed(
         if change < options.tolerance {
             // Final stick solve with the converged pressure.
             let (b_fin, slope_fin, correction, kink) = find_stick_zone(model, disc, &state, b)?;
-            state.traction.stick = Some(StickZone {
-                lo: -b_fin,
-                hi: b_fin,
-                correction,
-                kink,
-            });
+            state.traction.stick = Some(StickZone::new(-b_fin, b_fin, correction, kink));
             let admissibility = check_normal_state(model, &state, slope_fin, options.admissibility)
                 .map_err(|failure| {
                     if b_fin >= state.half_width {

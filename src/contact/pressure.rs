@@ -92,38 +92,56 @@ pub fn solve_pressure(
         a = (normal_load / i1).sqrt();
         c = 0.0;
     }
+    let coupled = kappa != 0.0;
+    if !coupled {
+        let a = (normal_load / i1).sqrt();
+        let psi: Vec<f64> = disc.unit_psi.iter().map(|u| a * scale * u).collect();
+        let pressure = BoundedSeries::from_nodes(&disc.bounded, &psi);
+        return Ok(PressureSolution {
+            half_width: a,
+            centre: 0.0,
+            pressure,
+            iterations: 1,
+        });
+    }
+    // G(a, c): the (a, c) that the consistency and resultant conditions give for the shear
+    // term sampled at the points of (a, c); solve G(x) = x by Broyden's method started as a
+    // plain fixed-point iteration (J = −I). The shear is sampled at moving points, so G is
+    // only piecewise smooth; Broyden copes where plain iteration can cycle.
     let mut rhs = vec![0.0; m + 1];
     let mut psi_q = vec![0.0; m];
-    let coupled = kappa != 0.0;
-    let max_iter = 100;
-    let mut last_change = f64::NAN;
-    for iter in 1..=max_iter {
-        let (lambda, iq) = if coupled {
-            for (r, &t) in rhs.iter_mut().zip(&disc.bounded.collocation) {
-                *r = -kappa / ystar * traction(c + a * t);
-            }
-            let lambda = disc.bounded.solve(&rhs, &mut psi_q);
-            (lambda, disc.bounded.integral(&psi_q))
-        } else {
-            (0.0, 0.0)
-        };
+    let mut evaluate = |a: f64, c: f64, psi_q: &mut Vec<f64>| -> (f64, f64) {
+        for (r, &t) in rhs.iter_mut().zip(&disc.bounded.collocation) {
+            *r = -kappa / ystar * traction(c + a * t);
+        }
+        let lambda = disc.bounded.solve(&rhs, psi_q);
+        let iq = disc.bounded.integral(psi_q);
         let c_new = if symmetric { 0.0 } else { lambda / scale };
         let a_new = (-iq + (iq * iq + 4.0 * i1 * normal_load).sqrt()) / (2.0 * i1);
-        if !(a_new.is_finite() && c_new.is_finite()) {
+        (a_new, c_new)
+    };
+    let a_scale = a;
+    let mut x = [a / a_scale, c / a_scale];
+    let g = evaluate(a, c, &mut psi_q);
+    let mut f = [g.0 / a_scale - x[0], g.1 / a_scale - x[1]];
+    let mut jac = [[-1.0, 0.0], [0.0, -1.0]];
+    let max_iter = 200;
+    let mut last = f64::INFINITY;
+    for iter in 1..=max_iter {
+        let norm = f[0].hypot(f[1]);
+        if !norm.is_finite() {
             return Err(SolveFailure::NonFinite {
                 field: "contact half-width",
             });
         }
-        let change = ((a_new - a).abs() + (c_new - c).abs()) / a_new;
-        last_change = change;
-        a = a_new;
-        c = c_new;
-        if !coupled || change < 1e-13 {
+        last = norm;
+        if norm < 1e-13 {
+            let (a, c) = (x[0] * a_scale, x[1] * a_scale);
             let psi: Vec<f64> = disc
                 .unit_psi
                 .iter()
                 .zip(&psi_q)
-                .map(|(u, q)| a * scale * u + if coupled { *q } else { 0.0 })
+                .map(|(u, q)| a * scale * u + q)
                 .collect();
             return Ok(PressureSolution {
                 half_width: a,
@@ -132,11 +150,50 @@ pub fn solve_pressure(
                 iterations: iter,
             });
         }
+        let det = jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0];
+        let mut dx = [
+            -(jac[1][1] * f[0] - jac[0][1] * f[1]) / det,
+            -(-jac[1][0] * f[0] + jac[0][0] * f[1]) / det,
+        ];
+        if !(dx[0].is_finite() && dx[1].is_finite()) || det.abs() < 1e-12 {
+            jac = [[-1.0, 0.0], [0.0, -1.0]];
+            dx = [f[0], f[1]];
+        }
+        // Keep a positive.
+        while x[0] + dx[0] <= 0.0 {
+            dx = [0.5 * dx[0], 0.5 * dx[1]];
+        }
+        let xn = [x[0] + dx[0], x[1] + dx[1]];
+        let g = evaluate(xn[0] * a_scale, xn[1] * a_scale, &mut psi_q);
+        let fn_ = [g.0 / a_scale - xn[0], g.1 / a_scale - xn[1]];
+        if fn_[0].hypot(fn_[1]) > 2.0 * f[0].hypot(f[1]) {
+            // Broyden's model went wrong: restart from a plain fixed-point step.
+            jac = [[-1.0, 0.0], [0.0, -1.0]];
+        }
+        let df = [fn_[0] - f[0], fn_[1] - f[1]];
+        let dd = dx[0] * dx[0] + dx[1] * dx[1];
+        if dd > 0.0 {
+            let jdx = [
+                jac[0][0] * dx[0] + jac[0][1] * dx[1],
+                jac[1][0] * dx[0] + jac[1][1] * dx[1],
+            ];
+            for i in 0..2 {
+                for j in 0..2 {
+                    jac[i][j] += (df[i] - jdx[i]) * dx[j] / dd;
+                }
+            }
+        }
+        x = xn;
+        f = fn_;
+        if symmetric {
+            x[1] = 0.0;
+            f[1] = 0.0;
+        }
     }
     Err(SolveFailure::NoConvergence {
         what: "contact half-width and centre",
         iterations: max_iter,
-        residual: last_change,
+        residual: last,
     })
 }
 

@@ -1,0 +1,564 @@
+//! The load-history driver: a piecewise-linear tangential load Q(t) walked step by step through
+//! a closed set of solver states, with the strain memory stored at the start of every monotonic
+//! phase (seed Section 4; `docs/formulation.md` §4).
+//!
+//! # States and transitions
+//! [`Regime`] is closed: normal loading, stick (hold), forward slip, reverse slip. The next
+//! regime is a pure function of the sign of ΔQ ([`next_regime`]): `ΔQ > 0` forward slip,
+//! `ΔQ < 0` reverse slip, `ΔQ = 0` stick (nothing changes, the state is carried over). A phase
+//! begins whenever the slip direction differs from the previous slip phase's (or at the first
+//! slip step after normal loading): then the memory is recomputed from the current state over
+//! the whole contact ([`Memory::committed`]). A hold between two segments of the same
+//! direction does not start a new phase.
+//!
+//! # Steps
+//! Each segment `(t0, Q0) → (t1, Q1)` is cut into `max(steps_per_segment, ⌈|ΔQ|/max_step⌉)`
+//! equal steps. Each step is solved by [`solve_slip`] from the committed state and memory,
+//! checked, and only then committed (trial, then commit). A failure stops the run with the
+//! step, t, Q and regime; the steps already solved are kept by the caller (observer).
+//!
+//! # Warm start
+//! Inside a phase the stick-zone ends are extrapolated linearly from the last two steps. At the
+//! start of a phase the zones that already slip in the new direction keep slipping and the
+//! others stick, with new slip zones of the Mindlin–Deresiewicz width
+//! `a(1 − √(1 − |ΔQ|/(2ηP)))` at the ends that start to slip.
+
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+
+use crate::contact::memory::Memory;
+use crate::contact::normal::NormalLoading;
+use crate::contact::pressure::Discretisation;
+use crate::contact::tangential::{SlipOptions, SlipStep, StepAdmissibility, solve_slip};
+use crate::contact::{ContactModel, ContactState};
+use crate::error::{Issue, SolveFailure};
+
+/// Solver state of a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Regime {
+    /// Monotonic normal loading (Spence's self-similar state).
+    NormalLoading,
+    /// Hold: ΔQ = 0, whole state unchanged.
+    Stick,
+    /// ΔQ > 0: both slip zones carry `q = +ηp`.
+    ForwardSlip,
+    /// ΔQ < 0: both slip zones carry `q = −ηp`.
+    ReverseSlip,
+}
+
+impl Regime {
+    /// `q/(ηp)` in the slip zones, `None` when nothing slips.
+    pub fn slip_sign(self) -> Option<f64> {
+        match self {
+            Regime::ForwardSlip => Some(1.0),
+            Regime::ReverseSlip => Some(-1.0),
+            Regime::Stick | Regime::NormalLoading => None,
+        }
+    }
+}
+
+/// The regime of a step with load increment `dq` (pure; `tol` absorbs round-off in ΔQ).
+pub fn next_regime(dq: f64, tol: f64) -> Regime {
+    if dq > tol {
+        Regime::ForwardSlip
+    } else if dq < -tol {
+        Regime::ReverseSlip
+    } else {
+        Regime::Stick
+    }
+}
+
+/// A piecewise-linear tangential load history in N/m.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LoadHistory {
+    /// `(t, Q)` points, t strictly increasing (s, N/m).
+    pub points: Vec<(f64, f64)>,
+    /// Minimum number of steps per segment.
+    pub steps_per_segment: usize,
+    /// Largest |ΔQ| of a step (N/m).
+    pub max_step: f64,
+}
+
+impl LoadHistory {
+    /// A history from a lead-in and a cycle block repeated `repeats` times. Cycle times are
+    /// relative to the start of each repetition (which is the end of the previous one).
+    pub fn with_cycles(
+        lead_in: &[(f64, f64)],
+        cycle: &[(f64, f64)],
+        repeats: usize,
+    ) -> Vec<(f64, f64)> {
+        let mut points = lead_in.to_vec();
+        for _ in 0..repeats {
+            let t0 = points.last().map_or(0.0, |p| p.0);
+            points.extend(cycle.iter().map(|(t, q)| (t0 + t, *q)));
+        }
+        points
+    }
+
+    /// Check the history before any solving: finite values, strictly increasing times, and
+    /// `|Q| < ηP` at every point (a point at or beyond ηP is gross sliding).
+    pub fn validate(&self, path: &str, limit: f64) -> Vec<Issue> {
+        let mut issues = Vec::new();
+        if self.points.is_empty() {
+            issues.push(Issue::new(
+                format!("{path}.points"),
+                "[] is invalid; it must hold at least one point",
+            ));
+        }
+        for (i, &(t, q)) in self.points.iter().enumerate() {
+            if !t.is_finite() {
+                issues.push(Issue::new(
+                    format!("{path}.points[{i}].t"),
+                    format!("{t} s is invalid; it must be finite"),
+                ));
+            }
+            if !q.is_finite() {
+                issues.push(Issue::new(
+                    format!("{path}.points[{i}].q"),
+                    format!("{q} N/m is invalid; it must be finite"),
+                ));
+            } else if q.abs() >= limit {
+                issues.push(Issue::new(
+                    format!("{path}.points[{i}].q"),
+                    format!(
+                        "{q} N/m (= {:.4} ηP) is invalid; it must satisfy |Q| < ηP = {limit} N/m (at or beyond ηP the contact slides as a whole)",
+                        q / limit
+                    ),
+                ));
+            }
+            if i > 0 {
+                let prev = self.points[i - 1].0;
+                if t.is_finite() && prev.is_finite() && t <= prev {
+                    issues.push(Issue::new(
+                        format!("{path}.points[{i}].t"),
+                        format!("{t} s is invalid; it must be > previous t = {prev} s"),
+                    ));
+                }
+            }
+        }
+        if self.steps_per_segment == 0 {
+            issues.push(Issue::new(
+                format!("{path}.steps_per_segment"),
+                "0 is invalid; it must be ≥ 1",
+            ));
+        }
+        if !(self.max_step.is_finite() && self.max_step > 0.0) {
+            issues.push(Issue::new(
+                format!("{path}.max_step"),
+                format!(
+                    "{} N/m is invalid; it must be finite and > 0",
+                    self.max_step
+                ),
+            ));
+        }
+        issues
+    }
+
+    /// The load steps `(t, Q)` after the first point, each with its segment index.
+    pub fn steps(&self) -> Vec<(usize, f64, f64)> {
+        let mut out = Vec::new();
+        for (k, w) in self.points.windows(2).enumerate() {
+            let ((t0, q0), (t1, q1)) = (w[0], w[1]);
+            let n = self
+                .steps_per_segment
+                .max(((q1 - q0).abs() / self.max_step).ceil() as usize)
+                .max(1);
+            let n = if (q1 - q0).abs() > 0.0 { n } else { 1 };
+            for i in 1..=n {
+                let f = i as f64 / n as f64;
+                out.push((k, t0 + f * (t1 - t0), q0 + f * (q1 - q0)));
+            }
+        }
+        out
+    }
+}
+
+/// One recorded step.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StepRecord {
+    /// Step number (0 = end of normal loading).
+    pub step: usize,
+    /// Time (s).
+    pub t: f64,
+    /// Tangential load Q (N/m).
+    pub q: f64,
+    /// Regime.
+    pub regime: Regime,
+    /// Phase number (0 = normal loading; increments at each reversal).
+    pub phase: usize,
+    /// Contact half-width a (m).
+    pub half_width: f64,
+    /// Eccentricity e = −c (m).
+    pub eccentricity: f64,
+    /// Stick-zone left end (m).
+    pub stick_lo: f64,
+    /// Stick-zone right end (m).
+    pub stick_hi: f64,
+    /// Block iterations.
+    pub iterations: usize,
+    /// Newton iterations of the stick-zone ends.
+    pub newton_iterations: usize,
+    /// Final relative change of the block iteration.
+    pub residual: f64,
+    /// Checks.
+    pub admissibility: StepAdmissibility,
+}
+
+/// Receives the accepted steps (progress bars, writers, test recorders).
+pub trait Observer {
+    /// Called once per accepted step with the committed state.
+    fn on_step(&mut self, _record: &StepRecord, _state: &ContactState) {}
+    /// Called when a new phase begins, with the memory that the phase will keep.
+    fn on_phase(&mut self, _phase: usize, _memory: &Memory) {}
+}
+
+/// An observer that does nothing.
+pub struct NoObserver;
+impl Observer for NoObserver {}
+
+/// A failed step, with its context.
+#[derive(Debug, Clone)]
+pub struct StepFailure {
+    /// Step number.
+    pub step: usize,
+    /// Time.
+    pub t: f64,
+    /// Q.
+    pub q: f64,
+    /// Regime attempted.
+    pub regime: Regime,
+    /// The failure.
+    pub failure: SolveFailure,
+}
+
+impl std::fmt::Display for StepFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "step {} (t = {} s, Q = {} N/m, {:?})",
+            self.step, self.t, self.q, self.regime
+        )
+    }
+}
+
+/// Driver state that outlives a step.
+#[derive(Debug, Clone)]
+pub struct DriverState {
+    /// Committed contact state.
+    pub state: ContactState,
+    /// Memory of the current phase.
+    pub memory: Memory,
+    /// Slip sign of the current phase (`None` before the first slip).
+    pub phase_sign: Option<f64>,
+    /// Phase number.
+    pub phase: usize,
+    /// Stick-zone ends of the last two steps of the phase, for extrapolation.
+    history: Vec<(f64, f64, f64)>,
+    /// Stick zone (with its correction chain) of the state that began the phase.
+    base: Option<Arc<crate::contact::StickZone>>,
+}
+
+impl DriverState {
+    /// Start from the end of normal loading.
+    pub fn after_normal_loading(normal: &NormalLoading) -> Self {
+        let state = normal.state.clone();
+        let b = normal.stick_half_width;
+        let memory =
+            Memory::after_normal_loading(Arc::new(state.clone()), normal.strain_slope, -b, b);
+        let base = normal.state.traction.stick.clone().map(Arc::new);
+        Self {
+            state,
+            memory,
+            phase_sign: None,
+            phase: 0,
+            history: Vec::new(),
+            base,
+        }
+    }
+}
+
+/// Initial guess of the stick zone at the first step of a phase with sign `sign` and
+/// increment `dq` from `prev`.
+fn phase_start_guess(model: &ContactModel, prev: &ContactState, sign: f64, dq: f64) -> (f64, f64) {
+    let (c, a) = (prev.centre, prev.half_width);
+    let width =
+        a * (1.0 - (1.0 - (dq.abs() / (2.0 * model.friction * prev.normal_load)).min(0.9)).sqrt());
+    let width = width.max(1e-6 * a);
+    let t = &prev.traction;
+    let (plo, phi) = t.stick.as_ref().map_or((c - a, c + a), |s| (s.lo, s.hi));
+    // A slip zone already slipping in the new direction keeps its end; the others stick.
+    let lo = if (t.left_sign - sign).abs() < 1e-12 {
+        plo
+    } else {
+        c - a + width
+    };
+    let hi = if (t.right_sign - sign).abs() < 1e-12 {
+        phi
+    } else {
+        c + a - width
+    };
+    (lo, hi)
+}
+
+/// A load point of the history: step number, time (s) and Q (N/m).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoadPoint {
+    /// Step number.
+    pub step: usize,
+    /// Time (s).
+    pub t: f64,
+    /// Tangential load (N/m).
+    pub q: f64,
+}
+
+/// Advance the driver by one load step.
+pub fn advance(
+    model: &ContactModel,
+    disc: &Discretisation,
+    driver: &mut DriverState,
+    point: LoadPoint,
+    options: SlipOptions,
+    observer: &mut dyn Observer,
+) -> Result<StepRecord, StepFailure> {
+    let LoadPoint { step, t, q } = point;
+    let dq = q - driver.state.tangential_load;
+    let regime = next_regime(dq, 1e-12 * model.friction * driver.state.normal_load);
+    let Some(sign) = regime.slip_sign() else {
+        // Hold: nothing changes.
+        let mut rec = record(step, t, driver, regime, None);
+        rec.q = q;
+        observer.on_step(&rec, &driver.state);
+        return Ok(rec);
+    };
+    let new_phase = driver.phase_sign != Some(sign);
+    let guess = if new_phase {
+        phase_start_guess(model, &driver.state, sign, dq)
+    } else {
+        match driver.history.as_slice() {
+            [.., (q1, l1, h1), (q2, l2, h2)] if (q2 - q1).abs() > 0.0 => {
+                let f = (q - q2) / (q2 - q1);
+                (l2 + f * (l2 - l1), h2 + f * (h2 - h1))
+            }
+            [.., (_, l, h)] => (*l, *h),
+            [] => phase_start_guess(model, &driver.state, sign, dq),
+        }
+    };
+    let memory = if new_phase {
+        match (&driver.phase_sign, driver.state.traction.stick.as_ref()) {
+            (None, _) => driver.memory.clone(),
+            (Some(_), Some(s)) => {
+                driver
+                    .memory
+                    .committed(Arc::new(driver.state.clone()), s.lo, s.hi)
+            }
+            (Some(_), None) => driver.memory.clone(),
+        }
+    } else {
+        driver.memory.clone()
+    };
+    let base = if new_phase {
+        driver.state.traction.stick.clone().map(Arc::new)
+    } else {
+        driver.base.clone()
+    };
+    let solved: SlipStep = solve_slip(
+        model,
+        disc,
+        &memory,
+        base.as_ref(),
+        &driver.state,
+        q,
+        sign,
+        guess,
+        options,
+    )
+    .map_err(|failure| StepFailure {
+        step,
+        t,
+        q,
+        regime,
+        failure,
+    })?;
+    if new_phase {
+        driver.phase += 1;
+        driver.phase_sign = Some(sign);
+        driver.memory = memory;
+        driver.base = base;
+        driver.history.clear();
+        observer.on_phase(driver.phase, &driver.memory);
+    }
+    driver.state = solved.state.clone();
+    let stick = driver
+        .state
+        .traction
+        .stick
+        .as_ref()
+        .expect("slip state has a stick zone");
+    driver.history.push((q, stick.lo, stick.hi));
+    if driver.history.len() > 2 {
+        driver.history.remove(0);
+    }
+    let rec = record(step, t, driver, regime, Some(&solved));
+    observer.on_step(&rec, &driver.state);
+    Ok(rec)
+}
+
+fn record(
+    step: usize,
+    t: f64,
+    driver: &DriverState,
+    regime: Regime,
+    solved: Option<&SlipStep>,
+) -> StepRecord {
+    let s = &driver.state;
+    let (lo, hi) = s
+        .traction
+        .stick
+        .as_ref()
+        .map_or((s.centre - s.half_width, s.centre + s.half_width), |z| {
+            (z.lo, z.hi)
+        });
+    StepRecord {
+        step,
+        t,
+        q: s.tangential_load,
+        regime,
+        phase: driver.phase,
+        half_width: s.half_width,
+        eccentricity: -s.centre,
+        stick_lo: lo,
+        stick_hi: hi,
+        iterations: solved.map_or(0, |x| x.iterations),
+        newton_iterations: solved.map_or(0, |x| x.newton_iterations),
+        residual: solved.map_or(0.0, |x| x.residual),
+        admissibility: solved.map_or_else(StepAdmissibility::default, |x| x.admissibility),
+    }
+}
+
+/// A finished run: the records and the final driver state.
+#[derive(Debug, Clone)]
+pub struct HistoryRun {
+    /// One record per accepted step (step 0 = end of normal loading).
+    pub records: Vec<StepRecord>,
+    /// The driver after the last step.
+    pub driver: DriverState,
+}
+
+/// A failed run: what was accepted before the failure, and the failure.
+#[derive(Debug, Clone)]
+pub struct HistoryFailure {
+    /// The steps accepted before the failure.
+    pub records: Vec<StepRecord>,
+    /// The driver at the last accepted step.
+    pub driver: DriverState,
+    /// The failed step.
+    pub failure: StepFailure,
+}
+
+/// Walk a whole history from the end of normal loading.
+pub fn run_history(
+    model: &ContactModel,
+    disc: &Discretisation,
+    normal: &NormalLoading,
+    history: &LoadHistory,
+    options: SlipOptions,
+    observer: &mut dyn Observer,
+) -> Result<HistoryRun, Box<HistoryFailure>> {
+    let mut driver = DriverState::after_normal_loading(normal);
+    let t0 = history.points.first().map_or(0.0, |p| p.0);
+    let mut records = vec![record(0, t0, &driver, Regime::NormalLoading, None)];
+    observer.on_step(&records[0], &driver.state);
+    let q0 = history.points.first().map_or(0.0, |p| p.1);
+    let mut steps = Vec::new();
+    if q0.abs() > 0.0 {
+        // Ramp from Q = 0 to the first point in one segment's worth of steps.
+        let n = history
+            .steps_per_segment
+            .max((q0.abs() / history.max_step).ceil() as usize);
+        for i in 1..=n {
+            steps.push((t0, q0 * i as f64 / n as f64));
+        }
+    }
+    steps.extend(history.steps().into_iter().map(|(_, t, q)| (t, q)));
+    for (i, (t, q)) in steps.into_iter().enumerate() {
+        match advance(
+            model,
+            disc,
+            &mut driver,
+            LoadPoint { step: i + 1, t, q },
+            options,
+            observer,
+        ) {
+            Ok(rec) => records.push(rec),
+            Err(failure) => {
+                return Err(Box::new(HistoryFailure {
+                    records,
+                    driver,
+                    failure,
+                }));
+            }
+        }
+    }
+    Ok(HistoryRun { records, driver })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transition_table() {
+        let tol = 1e-9;
+        for (dq, expected) in [
+            (1.0, Regime::ForwardSlip),
+            (-1.0, Regime::ReverseSlip),
+            (0.0, Regime::Stick),
+            (1e-12, Regime::Stick),
+        ] {
+            assert_eq!(next_regime(dq, tol), expected, "dq = {dq}");
+        }
+        assert_eq!(Regime::ForwardSlip.slip_sign(), Some(1.0));
+        assert_eq!(Regime::ReverseSlip.slip_sign(), Some(-1.0));
+        assert_eq!(Regime::Stick.slip_sign(), None);
+        assert_eq!(Regime::NormalLoading.slip_sign(), None);
+    }
+
+    #[test]
+    fn history_validation_names_each_point() {
+        let h = LoadHistory {
+            points: vec![(0.0, 0.0), (1.0, 500.0), (0.5, 700.0)],
+            steps_per_segment: 4,
+            max_step: 10.0,
+        };
+        let issues = h.validate("tangential_history", 600.0);
+        let paths: Vec<_> = issues.iter().map(|i| i.path.as_str()).collect();
+        assert_eq!(
+            paths,
+            [
+                "tangential_history.points[2].q",
+                "tangential_history.points[2].t"
+            ]
+        );
+        assert!(issues[0].message.contains("|Q| < ηP"));
+        assert!(issues[1].message.contains("must be > previous t = 1 s"));
+    }
+
+    #[test]
+    fn steps_cover_each_segment_and_holds_take_one_step() {
+        let h = LoadHistory {
+            points: vec![(0.0, 0.0), (1.0, 10.0), (2.0, 10.0), (3.0, -10.0)],
+            steps_per_segment: 2,
+            max_step: 4.0,
+        };
+        let steps = h.steps();
+        assert_eq!(steps.len(), 3 + 1 + 5);
+        assert!((steps[2].2 - 10.0).abs() < 1e-12 && (steps[3].2 - 10.0).abs() < 1e-12);
+        assert!((steps.last().unwrap().2 + 10.0).abs() < 1e-12);
+        let cyc =
+            LoadHistory::with_cycles(&[(0.0, 0.0), (1.0, 5.0)], &[(1.0, -5.0), (2.0, 5.0)], 2);
+        assert_eq!(cyc.len(), 6);
+        assert!((cyc[5].0 - 5.0).abs() < 1e-12);
+    }
+}
