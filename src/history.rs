@@ -196,6 +196,10 @@ pub struct StepRecord {
     pub stick_lo: f64,
     /// Stick-zone right end (m).
     pub stick_hi: f64,
+    /// `q/(ηp)` in the left slip zone (±1; 0 before any slip).
+    pub left_slip_sign: f64,
+    /// `q/(ηp)` in the right slip zone.
+    pub right_slip_sign: f64,
     /// Block iterations.
     pub iterations: usize,
     /// Newton iterations of the stick-zone ends.
@@ -288,14 +292,16 @@ fn phase_start_guess(model: &ContactModel, prev: &ContactState, sign: f64, dq: f
     let width = width.max(1e-6 * a);
     let t = &prev.traction;
     let (plo, phi) = t.stick.as_ref().map_or((c - a, c + a), |s| (s.lo, s.hi));
-    // A slip zone already slipping in the new direction keeps its end; the others stick.
+    // A slip zone already slipping in the new direction keeps slipping and its stick end moves
+    // inward at once (start just inside it: outside, the residuals do not depend on that end);
+    // elsewhere new slip zones open at the contact ends.
     let lo = if (t.left_sign - sign).abs() < 1e-12 {
-        plo
+        plo + width
     } else {
         c - a + width
     };
     let hi = if (t.right_sign - sign).abs() < 1e-12 {
-        phi
+        phi - width
     } else {
         c + a - width
     };
@@ -430,6 +436,8 @@ fn record(
         eccentricity: -s.centre,
         stick_lo: lo,
         stick_hi: hi,
+        left_slip_sign: s.traction.left_sign,
+        right_slip_sign: s.traction.right_sign,
         iterations: solved.map_or(0, |x| x.iterations),
         newton_iterations: solved.map_or(0, |x| x.newton_iterations),
         residual: solved.map_or(0.0, |x| x.residual),

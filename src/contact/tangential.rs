@@ -35,17 +35,15 @@ use crate::quadrature::{BoundedSeries, UnboundedSeries};
 
 use super::memory::Memory;
 use super::normal::arcsine_moment;
-use super::pressure::{
-    Discretisation, electric_resultants, solve_potential_charge, solve_pressure,
-};
-use super::{ContactModel, ContactState, StickZone, Traction, graded_rule};
+use super::pressure::{Discretisation, electric_resultants};
+use super::{ContactModel, ContactState, StickZone, graded_rule};
 
 /// Options of a tangential step.
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct SlipOptions {
-    /// Relative tolerance of the block iteration on (a, c, lo, hi), relative to a.
+    /// Tolerance on the norm of the four dimensionless residuals.
     pub tolerance: f64,
-    /// Maximum block iterations.
+    /// Maximum Newton iterations.
     pub max_iterations: usize,
     /// Allowed violation of `|q| ≤ ηp` (relative to `η p0`) and of the slip direction
     /// (relative to the largest slip increment).
@@ -55,8 +53,8 @@ pub struct SlipOptions {
 impl Default for SlipOptions {
     fn default() -> Self {
         Self {
-            tolerance: 1e-10,
-            max_iterations: 100,
+            tolerance: 1e-13,
+            max_iterations: 50,
             admissibility: 1e-3,
         }
     }
@@ -78,263 +76,257 @@ pub struct StepAdmissibility {
 pub struct SlipStep {
     /// The new state.
     pub state: ContactState,
-    /// Block iterations.
+    /// Newton iterations.
     pub iterations: usize,
-    /// Newton iterations of the stick-zone ends, summed.
+    /// Residual evaluations (each a coupled linear solve at fixed geometry).
     pub newton_iterations: usize,
-    /// Final relative change of the block iteration.
+    /// Final residual norm.
     pub residual: f64,
     /// The checks.
     pub admissibility: StepAdmissibility,
 }
 
-struct StickFit {
+/// The four geometric unknowns of a step: stick-zone ends and contact half-width and centre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Geometry {
     lo: f64,
     hi: f64,
-    series: BoundedSeries,
-    inherited: Option<Arc<StickZone>>,
-    iterations: usize,
+    a: f64,
+    c: f64,
 }
 
-impl StickFit {
-    fn zone(&self) -> StickZone {
-        StickZone {
-            inherited: self.inherited.clone(),
-            ..StickZone::new(self.lo, self.hi, self.series.clone(), 0.0)
-        }
+/// Everything a step needs besides the geometry.
+struct StepProblem<'a> {
+    model: &'a ContactModel,
+    disc: &'a Discretisation,
+    memory: &'a Memory,
+    base: Option<&'a Arc<StickZone>>,
+    /// Slip signs of the left and right slip zones.
+    signs: (f64, f64),
+    normal_load: f64,
+    tangential_load: f64,
+}
+
+impl StepProblem<'_> {
+    fn valid(&self, g: &Geometry) -> bool {
+        g.a > 0.0 && g.lo > g.c - g.a && g.hi < g.c + g.a && g.hi - g.lo > 1e-9 * g.a
     }
-}
 
-/// Residuals (consistency/(η p0), force/(η P)) of the stick problem for trial ends.
-#[allow(clippy::too_many_arguments)]
-fn stick_residual(
-    model: &ContactModel,
-    disc: &Discretisation,
-    memory: &Memory,
-    base: Option<&Arc<StickZone>>,
-    state: &ContactState,
-    sign: f64,
-    lo: f64,
-    hi: f64,
-) -> ([f64; 2], BoundedSeries, Option<Arc<StickZone>>) {
-    let inherited = base.and_then(|b| b.contained_in(lo, hi));
-    let m = disc.nodes();
-    let y11 = model.compliance.y11;
-    let eta = model.friction;
-    let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
-    let local = model.local_pressure_strain(state.split);
-    let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
-    let rhs: Vec<f64> = disc
-        .bounded
-        .collocation
-        .iter()
-        .map(|t| {
-            let x = mid + half * t;
-            let tau = (x - state.centre) / state.half_width;
-            let inherited_cauchy = inherited.as_ref().map_or(0.0, |z| z.correction_cauchy(x));
-            (memory.strain(model, x)
-                + local * state.pressure_at(x)
-                + w13 * state.potential_charge.density(tau)
-                - sign * eta * y11 * state.pressure_cauchy(x))
-                / y11
-                - inherited_cauchy
-        })
-        .collect();
-    let mut psi = vec![0.0; m];
-    let lambda = disc.bounded.solve(&rhs, &mut psi);
-    let force = half * disc.bounded.integral(&psi);
-    let p0 = state.pressure_at(state.centre).max(1e-300);
-    let target = state.tangential_load
-        - sign * eta * state.normal_load
-        - inherited.as_ref().map_or(0.0, |z| z.correction_integral());
-    let series = BoundedSeries::from_nodes(&disc.bounded, &psi);
-    (
-        [
-            lambda / (eta * p0),
-            (force - target) / (eta * state.normal_load),
-        ],
-        series,
-        inherited,
-    )
-}
-
-/// Newton on (lo, hi) for fixed p and w.
-fn fit_stick_zone(
-    model: &ContactModel,
-    disc: &Discretisation,
-    memory: &Memory,
-    base: Option<&Arc<StickZone>>,
-    state: &ContactState,
-    sign: f64,
-    guess: (f64, f64),
-) -> Result<StickFit, SolveFailure> {
-    let (c, a) = (state.centre, state.half_width);
-    let (left, right) = (c - a, c + a);
-    let valid = |lo: f64, hi: f64| lo > left && hi < right && hi - lo > 1e-9 * a;
-    let clamp = |x: f64| x.clamp(left + 1e-12 * a, right - 1e-12 * a);
-    let (mut lo, mut hi) = (clamp(guess.0), clamp(guess.1));
-    if !valid(lo, hi) {
-        lo = c - 0.5 * a;
-        hi = c + 0.5 * a;
+    /// Solve the linear problem at fixed geometry (pressure, charge and stick traction, coupled
+    /// through κq, w13 w and the slip traction, by fixed-point iteration from `guess`) and
+    /// return the four residuals: pressure consistency and resultant, stick consistency and
+    /// force, each made dimensionless.
+    fn evaluate(
+        &self,
+        g: &Geometry,
+        guess: &ContactState,
+    ) -> Result<([f64; 4], ContactState), SolveFailure> {
+        let inherited = self.base.and_then(|b| b.contained_in(g.lo, g.hi));
+        self.evaluate_with(g, guess, inherited)
     }
-    let norm = |r: &[f64; 2]| r[0].hypot(r[1]);
-    let (mut r, mut series, mut inherited) =
-        stick_residual(model, disc, memory, base, state, sign, lo, hi);
-    let tol = 1e-12;
-    for it in 0..100 {
-        if norm(&r) < tol {
-            return Ok(StickFit {
-                lo,
-                hi,
-                series,
-                inherited,
-                iterations: it,
-            });
-        }
-        let d = 1e-7 * a;
-        let d_lo = if valid(lo - d, hi) { -d } else { d };
-        let d_hi = if valid(lo, hi + d) { d } else { -d };
-        let (r_lo, _, _) = stick_residual(model, disc, memory, base, state, sign, lo + d_lo, hi);
-        let (r_hi, _, _) = stick_residual(model, disc, memory, base, state, sign, lo, hi + d_hi);
-        let j = [
-            [(r_lo[0] - r[0]) / d_lo, (r_hi[0] - r[0]) / d_hi],
-            [(r_lo[1] - r[1]) / d_lo, (r_hi[1] - r[1]) / d_hi],
-        ];
-        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        if !(det.is_finite() && det.abs() > 0.0) {
-            break;
-        }
-        let step_lo = -(j[1][1] * r[0] - j[0][1] * r[1]) / det;
-        let step_hi = -(-j[1][0] * r[0] + j[0][0] * r[1]) / det;
-        let mut alpha = 1.0;
-        let mut accepted = false;
-        for _ in 0..40 {
-            let (nl, nh) = (lo + alpha * step_lo, hi + alpha * step_hi);
-            if valid(nl, nh) {
-                let (nr, ns, ni) = stick_residual(model, disc, memory, base, state, sign, nl, nh);
-                if norm(&nr) < norm(&r) * (1.0 - 1e-4 * alpha) || norm(&nr) < tol {
-                    lo = nl;
-                    hi = nh;
-                    r = nr;
-                    series = ns;
-                    inherited = ni;
-                    accepted = true;
-                    break;
-                }
+
+    /// As [`Self::evaluate`], with the inherited correction chosen by the caller (the
+    /// finite-difference Jacobian keeps the base point's choice so that it does not straddle
+    /// a switch).
+    fn evaluate_with(
+        &self,
+        g: &Geometry,
+        guess: &ContactState,
+        inherited: Option<Arc<StickZone>>,
+    ) -> Result<([f64; 4], ContactState), SolveFailure> {
+        let (model, disc) = (self.model, self.disc);
+        let m = disc.nodes();
+        let split = guess.split;
+        let ystar = model.pressure_compliance(split);
+        let kappa = model.pressure_shear_coupling(split);
+        let y11 = model.compliance.y11;
+        let eta = model.friction;
+        let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
+        let local = model.local_pressure_strain(split);
+        let (mid, half) = (0.5 * (g.lo + g.hi), 0.5 * (g.hi - g.lo));
+        let stick_points: Vec<f64> = disc
+            .bounded
+            .collocation
+            .iter()
+            .map(|t| mid + half * t)
+            .collect();
+        let pressure_points: Vec<f64> = disc
+            .bounded
+            .collocation
+            .iter()
+            .map(|t| g.c + g.a * t)
+            .collect();
+        let charge_points: Vec<f64> = disc
+            .unbounded
+            .collocation
+            .iter()
+            .map(|t| g.c + g.a * t)
+            .collect();
+        // Parts of the stick right-hand side that do not change in the inner iteration.
+        let fixed: Vec<f64> = stick_points
+            .iter()
+            .map(|&x| {
+                self.memory.strain(model, x) / y11
+                    - inherited.as_ref().map_or(0.0, |z| z.correction_cauchy(x))
+            })
+            .collect();
+        let inherited_force = inherited.as_ref().map_or(0.0, |z| z.correction_integral());
+        let mut state = guess.clone();
+        state.half_width = g.a;
+        state.centre = g.c;
+        state.tangential_load = self.tangential_load;
+        state.traction.friction = eta;
+        state.traction.left_sign = self.signs.0;
+        state.traction.right_sign = self.signs.1;
+        let mut q_old: Vec<f64> = pressure_points
+            .iter()
+            .map(|&x| guess.traction_at(x))
+            .collect();
+        let mut q_charge: Vec<f64> = charge_points
+            .iter()
+            .map(|&x| guess.traction_at(x))
+            .collect();
+        let mut rhs = vec![0.0; m + 1];
+        let mut psi = vec![0.0; m];
+        let mut theta = vec![0.0; m];
+        let scale = 1.0 / (model.radius * ystar);
+        let p_scale = g.a * scale;
+        let (mut lambda_p, mut lambda_q) = (0.0, 0.0);
+        for _ in 0..100 {
+            // Pressure for the current shear traction (seed eqs. 52, 54, 56).
+            for ((r, &x), q) in rhs.iter_mut().zip(&pressure_points).zip(&q_old) {
+                *r = -x * scale - kappa / ystar * q;
             }
-            alpha *= 0.5;
+            lambda_p = disc.bounded.solve(&rhs, &mut psi);
+            state.pressure = BoundedSeries::from_nodes(&disc.bounded, &psi);
+            // Charge (seed eqs. 53, 55, 41–42) for the current shear traction.
+            if split.conducting {
+                let e = model
+                    .compliance
+                    .electric
+                    .expect("conducting punch on a piezoelectric half-plane");
+                let j_q = arcsine_moment(&state);
+                let (charge, potential) = electric_resultants(model, g.a, self.normal_load, j_q);
+                state.charge = charge;
+                state.potential = potential;
+                let free = charge - model.pressure_charge(self.normal_load);
+                let crhs: Vec<f64> = q_charge.iter().map(|q| -e.w13 / e.y33 * q).collect();
+                disc.unbounded.solve(&crhs, free / g.a, &mut theta);
+                state.potential_charge = UnboundedSeries::from_nodes(&disc.unbounded, &theta);
+            }
+            // Stick traction (seed eqs. 50–51/58–59, 60, 63); `H'(pS)` is `s H'p` when both slip
+            // zones have the sign s.
+            state.traction.stick = Some(StickZone::new(g.lo, g.hi, BoundedSeries::default(), 0.0));
+            let srhs: Vec<f64> = stick_points
+                .iter()
+                .zip(&fixed)
+                .map(|(&x, f)| {
+                    let tau = (x - g.c) / g.a;
+                    f + (local * state.pressure_at(x) + w13 * state.potential_charge.density(tau)
+                        - eta * y11 * state.shape_cauchy(x))
+                        / y11
+                })
+                .collect();
+            let mut psi_q = vec![0.0; m];
+            lambda_q = disc.bounded.solve(&srhs, &mut psi_q);
+            state.traction.stick = Some(StickZone {
+                inherited: inherited.clone(),
+                ..StickZone::new(
+                    g.lo,
+                    g.hi,
+                    BoundedSeries::from_nodes(&disc.bounded, &psi_q),
+                    0.0,
+                )
+            });
+            let q_new: Vec<f64> = pressure_points
+                .iter()
+                .map(|&x| state.traction_at(x))
+                .collect();
+            let p0 = state.pressure_at(g.c).abs().max(1e-300);
+            let change = q_new
+                .iter()
+                .zip(&q_old)
+                .map(|(n, o)| (n - o).abs())
+                .fold(0.0, f64::max)
+                / (eta * p0);
+            q_old = q_new;
+            if split.conducting {
+                q_charge = charge_points
+                    .iter()
+                    .map(|&x| state.traction_at(x))
+                    .collect();
+            }
+            if kappa == 0.0 && !split.conducting || change < 1e-14 {
+                break;
+            }
         }
-        if !accepted {
-            break;
-        }
+        let p0 = state.pressure_at(g.c).abs().max(1e-300);
+        let pressure_force = g.a * state.pressure.integral();
+        let stick = state.traction.stick.as_ref().expect("set above");
+        let shape_force = if (self.signs.0 - self.signs.1).abs() > 0.0 {
+            // ∫ p S dx over the contact, piecewise by the graded rule.
+            let (nodes, weights) = graded_rule();
+            let ends = [g.c - g.a, g.lo, g.hi, g.c + g.a];
+            ends.windows(2)
+                .map(|e| {
+                    let (m2, h2) = (0.5 * (e[0] + e[1]), 0.5 * (e[1] - e[0]));
+                    nodes
+                        .iter()
+                        .zip(weights)
+                        .map(|(u, w)| {
+                            w * h2 * state.pressure_at(m2 + h2 * u) * state.slip_shape(m2 + h2 * u)
+                        })
+                        .sum::<f64>()
+                })
+                .sum()
+        } else {
+            self.signs.1 * pressure_force
+        };
+        let q_force = half * stick.correction.integral() + inherited_force + eta * shape_force;
+        let residual = [
+            lambda_p / p_scale,
+            (pressure_force - self.normal_load) / self.normal_load,
+            lambda_q / (eta * p0),
+            (q_force - self.tangential_load) / (eta * self.normal_load),
+        ];
+        Ok((residual, state))
     }
-    // Newton stalled (the residuals have square-root kinks where a stick end crosses an old
-    // stick/slip boundary of the memory): nested bracketed roots, consistency in the centre
-    // of the zone for each half-width, force in the half-width.
-    nested_fit(model, disc, memory, base, state, sign, (lo, hi))
 }
 
-fn nested_fit(
-    model: &ContactModel,
-    disc: &Discretisation,
-    memory: &Memory,
-    base: Option<&Arc<StickZone>>,
-    state: &ContactState,
-    sign: f64,
-    guess: (f64, f64),
-) -> Result<StickFit, SolveFailure> {
-    use super::roots::bracketed_root;
-    let (c, a) = (state.centre, state.half_width);
-    let mut evaluations = 0usize;
-    let centre_for = |half: f64, mid_guess: f64, evaluations: &mut usize| -> Option<f64> {
-        let lower = c - a + half * (1.0 + 1e-12);
-        let upper = c + a - half * (1.0 + 1e-12);
-        if upper <= lower {
+fn norm(r: &[f64; 4]) -> f64 {
+    r.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+/// Solve the 4×4 linear system `J dx = −r` by Gaussian elimination with partial pivoting.
+#[allow(clippy::needless_range_loop)]
+fn solve4(mut j: [[f64; 4]; 4], r: [f64; 4]) -> Option<[f64; 4]> {
+    let mut b = r.map(|v| -v);
+    for col in 0..4 {
+        let piv = (col..4).max_by(|&x, &y| j[x][col].abs().total_cmp(&j[y][col].abs()))?;
+        if j[piv][col].abs() < 1e-300 {
             return None;
         }
-        let mut f = |mid: f64| {
-            *evaluations += 1;
-            stick_residual(
-                model,
-                disc,
-                memory,
-                base,
-                state,
-                sign,
-                mid - half,
-                mid + half,
-            )
-            .0[0]
-        };
-        bracketed_root(&mut f, mid_guess, lower, upper, 1e-3 * a, 1e-13 * a)
-    };
-    let half0 = 0.5 * (guess.1 - guess.0);
-    let mid0 = 0.5 * (guess.1 + guess.0);
-    let mut last_mid = mid0;
-    let mut force = |half: f64| match centre_for(half, last_mid, &mut evaluations) {
-        Some(mid) => {
-            last_mid = mid;
-            stick_residual(
-                model,
-                disc,
-                memory,
-                base,
-                state,
-                sign,
-                mid - half,
-                mid + half,
-            )
-            .0[1]
+        j.swap(col, piv);
+        b.swap(col, piv);
+        for row in col + 1..4 {
+            let f = j[row][col] / j[col][col];
+            for k in col..4 {
+                j[row][k] -= f * j[col][k];
+            }
+            b[row] -= f * b[col];
         }
-        None => f64::NAN,
-    };
-    let half = bracketed_root(
-        &mut force,
-        half0,
-        1e-9 * a,
-        a * (1.0 - 1e-12),
-        1e-3 * a,
-        1e-13 * a,
-    )
-    .ok_or(SolveFailure::NoConvergence {
-        what: "stick-zone ends (bracketing)",
-        iterations: evaluations,
-        residual: f64::NAN,
-    })?;
-    let mid = centre_for(half, last_mid, &mut evaluations).ok_or(SolveFailure::NoConvergence {
-        what: "stick-zone centre (bracketing)",
-        iterations: evaluations,
-        residual: f64::NAN,
-    })?;
-    let (r, series, inherited) = stick_residual(
-        model,
-        disc,
-        memory,
-        base,
-        state,
-        sign,
-        mid - half,
-        mid + half,
-    );
-    if r[0].hypot(r[1]) < 1e-8 {
-        Ok(StickFit {
-            lo: mid - half,
-            hi: mid + half,
-            series,
-            inherited,
-            iterations: evaluations,
-        })
-    } else {
-        Err(SolveFailure::NoConvergence {
-            what: "stick-zone ends (bracketing)",
-            iterations: evaluations,
-            residual: r[0].hypot(r[1]),
-        })
     }
+    let mut x = [0.0; 4];
+    for row in (0..4).rev() {
+        let s: f64 = (row + 1..4).map(|k| j[row][k] * x[k]).sum();
+        x[row] = (b[row] - s) / j[row][row];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 /// Solve one step at tangential load `tangential_load` with slip sign `sign`, starting from
-/// `start` (the previous step) and the stick-zone guess `guess`.
+/// `start` (the previous step), the stick-zone guess `guess` and the phase's inherited
+/// correction chain `base`.
 #[allow(clippy::too_many_arguments)]
 pub fn solve_slip(
     model: &ContactModel,
@@ -347,74 +339,160 @@ pub fn solve_slip(
     guess: (f64, f64),
     options: SlipOptions,
 ) -> Result<SlipStep, SolveFailure> {
-    let eta = model.friction;
-    let normal_load = start.normal_load;
-    let mut state = start.clone();
-    state.tangential_load = tangential_load;
-    state.traction = Traction {
-        friction: eta,
-        left_sign: sign,
-        right_sign: sign,
-        stick: None,
+    // Both slip zones normally follow the load (seed Section 4); right after a reversal in a
+    // coupled contact one edge may keep its previous direction while the contact shifts, so
+    // the mixed states are tried when the standard one has no solution.
+    //
+    // The stick ends can also jump: when the load passes an earlier turning point (Masing
+    // memory), the part of the zone that is already at the friction limit slips at once and
+    // the ends move to an older stick/slip boundary of the memory. So the remembered
+    // boundaries inside the current zone are tried as starting points when the warm start fails.
+    let (c, a) = (start.centre, start.half_width);
+    let inset = 1e-3 * a;
+    let breaks: Vec<f64> = memory
+        .breakpoints()
+        .into_iter()
+        .filter(|&x| x > guess.0.min(c - a) - a && x < guess.1.max(c + a) + a)
+        .collect();
+    let mut guesses = vec![guess];
+    for i in 0..breaks.len() / 2 {
+        let (l, r) = (breaks[i], breaks[breaks.len() - 1 - i]);
+        if r - l > 2.0 * inset && l > c - a && r < c + a {
+            guesses.push((l + inset, r - inset));
+        }
+    }
+    let mut first_failure = None;
+    for signs in [(sign, sign), (-sign, sign), (sign, -sign)] {
+        for &guess in &guesses {
+            let problem = StepProblem {
+                model,
+                disc,
+                memory,
+                base,
+                signs,
+                normal_load: start.normal_load,
+                tangential_load,
+            };
+            match solve_geometry(&problem, start, guess, options) {
+                Ok(step) => return Ok(step),
+                Err(e) => {
+                    first_failure.get_or_insert(e);
+                }
+            }
+        }
+    }
+    Err(first_failure.expect("at least one attempt"))
+}
+
+#[allow(clippy::needless_range_loop)]
+fn solve_geometry(
+    problem: &StepProblem<'_>,
+    start: &ContactState,
+    guess: (f64, f64),
+    options: SlipOptions,
+) -> Result<SlipStep, SolveFailure> {
+    let model = problem.model;
+    let (a0, c0) = (start.half_width, start.centre);
+    let clamp_lo = |lo: f64| lo.max(c0 - a0 * (1.0 - 1e-9));
+    let clamp_hi = |hi: f64| hi.min(c0 + a0 * (1.0 - 1e-9));
+    let mut g = Geometry {
+        lo: clamp_lo(guess.0),
+        hi: clamp_hi(guess.1),
+        a: a0,
+        c: c0,
     };
-    let (mut lo, mut hi) = guess;
-    let mut newton = 0;
-    let mut last_change = f64::INFINITY;
-    for iter in 1..=options.max_iterations {
-        let fit = fit_stick_zone(model, disc, memory, base, &state, sign, (lo, hi))?;
-        newton += fit.iterations;
-        let (a_old, c_old) = (state.half_width, state.centre);
-        let change_ends = (fit.lo - lo).abs() + (fit.hi - hi).abs();
-        lo = fit.lo;
-        hi = fit.hi;
-        state.traction.stick = Some(fit.zone());
-        let lagged = state.clone();
-        let q = |x: f64| lagged.traction_at(x);
-        let pressure = solve_pressure(
-            model,
-            disc,
-            state.split,
-            normal_load,
-            &q,
-            (a_old, c_old),
-            false,
-        )?;
-        state.half_width = pressure.half_width;
-        state.centre = pressure.centre;
-        state.pressure = pressure.pressure;
-        let j_q = arcsine_moment(&state);
-        let (charge, potential) = electric_resultants(model, state.half_width, normal_load, j_q);
-        state.charge = charge;
-        state.potential = potential;
-        state.potential_charge = if state.split.conducting {
-            let free = charge - model.pressure_charge(normal_load);
-            solve_potential_charge(model, disc, state.half_width, state.centre, free, &q)
-        } else {
-            UnboundedSeries::default()
-        };
-        let change =
-            (change_ends + (state.half_width - a_old).abs() + (state.centre - c_old).abs())
-                / state.half_width;
-        last_change = change;
-        if change < options.tolerance {
-            let fit = fit_stick_zone(model, disc, memory, base, &state, sign, (lo, hi))?;
-            newton += fit.iterations;
-            state.traction.stick = Some(fit.zone());
+    if !problem.valid(&g) {
+        g.lo = c0 - 0.5 * a0;
+        g.hi = c0 + 0.5 * a0;
+    }
+    let (mut r, mut state) = problem.evaluate(&g, start)?;
+    let mut evaluations = 1;
+    for iter in 0..options.max_iterations {
+        let size = norm(&r);
+        if std::env::var("FRETSIM_TRACE").is_ok() {
+            eprintln!("newton {iter}: {:?} r {:?}", g, r);
+        }
+        if size < options.tolerance {
             let admissibility = assess_step(model, start, &state);
             check(&admissibility, &state, options.admissibility)?;
             return Ok(SlipStep {
                 state,
                 iterations: iter,
-                newton_iterations: newton,
-                residual: change,
+                newton_iterations: evaluations,
+                residual: size,
                 admissibility,
             });
         }
+        // Finite-difference Jacobian: steps well above evaluation noise, well inside the
+        // contact (the residuals have square-root behaviour at its ends).
+        let room = (g.lo - (g.c - g.a)).min(g.c + g.a - g.hi);
+        let d = (1e-6 * g.a).min(0.1 * room).max(1e-10 * g.a);
+        let mut jac = [[0.0; 4]; 4];
+        for k in 0..4 {
+            let mut gk = g;
+            let step = match k {
+                0 => {
+                    gk.lo += d;
+                    d
+                }
+                1 => {
+                    gk.hi -= d;
+                    -d
+                }
+                2 => {
+                    gk.a += d;
+                    d
+                }
+                _ => {
+                    gk.c += d;
+                    d
+                }
+            };
+            let chosen = state
+                .traction
+                .stick
+                .as_ref()
+                .and_then(|z| z.inherited.clone());
+            let (rk, _) = problem.evaluate_with(&gk, &state, chosen)?;
+            evaluations += 1;
+            for i in 0..4 {
+                jac[i][k] = (rk[i] - r[i]) / step;
+            }
+        }
+        let Some(dx) = solve4(jac, r) else { break };
+        if std::env::var("FRETSIM_TRACE").is_ok() {
+            eprintln!("  J {:?} dx {:?}", jac, dx);
+        }
+        let mut alpha = 1.0;
+        let mut accepted = false;
+        for _ in 0..30 {
+            let gn = Geometry {
+                lo: g.lo + alpha * dx[0],
+                hi: g.hi + alpha * dx[1],
+                a: g.a + alpha * dx[2],
+                c: g.c + alpha * dx[3],
+            };
+            if problem.valid(&gn) {
+                let (rn, sn) = problem.evaluate(&gn, &state)?;
+                evaluations += 1;
+                if norm(&rn) < (1.0 - 1e-4 * alpha) * size {
+                    g = gn;
+                    r = rn;
+                    state = sn;
+                    accepted = true;
+                    break;
+                }
+            }
+            alpha *= 0.5;
+        }
+        if !accepted {
+            break;
+        }
     }
     Err(SolveFailure::NoConvergence {
-        what: "tangential step (block iteration)",
-        iterations: options.max_iterations,
-        residual: last_change,
+        what: "tangential step (Newton on stick ends, a, c)",
+        iterations: evaluations,
+        residual: norm(&r),
     })
 }
 
@@ -451,7 +529,6 @@ pub fn assess_step(
     new: &ContactState,
 ) -> StepAdmissibility {
     let stick = new.traction.stick.as_ref().expect("slip state");
-    let sign = new.traction.right_sign;
     let eta = model.friction;
     let (c, a) = (new.centre, new.half_width);
     let p0 = new.pressure_at(c);
@@ -473,7 +550,11 @@ pub fn assess_step(
     let (nodes, weights) = graded_rule();
     let d_strain = |s: f64| new.strain_at(model, s) - old.strain_at(model, s);
     let mut slips = Vec::new();
-    for (from, to) in [(stick.hi, c + a), (stick.lo, c - a)] {
+    let zones = [
+        (stick.hi, c + a, new.traction.right_sign),
+        (stick.lo, c - a, new.traction.left_sign),
+    ];
+    for (from, to, zone_sign) in zones {
         for f in [0.25, 0.5, 0.75, 1.0] {
             let x = from + f * (to - from);
             let (mid, half) = (0.5 * (from + x), 0.5 * (x - from));
@@ -482,13 +563,16 @@ pub fn assess_step(
                 .zip(weights)
                 .map(|(u, w)| w * half * d_strain(mid + half * u))
                 .sum();
-            slips.push(slip);
+            slips.push((zone_sign, slip));
         }
     }
-    let largest = slips.iter().fold(0.0f64, |m, s| m.max(s.abs())).max(1e-300);
+    let largest = slips
+        .iter()
+        .fold(0.0f64, |m, (_, s)| m.max(s.abs()))
+        .max(1e-300);
     out.slip_reversal = slips
         .iter()
-        .map(|s| sign * s / largest)
+        .map(|(zs, s)| zs * s / largest)
         .fold(f64::NEG_INFINITY, f64::max);
     out
 }
