@@ -52,6 +52,7 @@ pub fn solve_frictionless(
             right_sign: 0.0,
             stick: None,
         },
+        shape_table: None,
     };
     if !(state.half_width.is_finite() && state.centre.is_finite()) {
         return Err(SolveFailure::NonFinite {

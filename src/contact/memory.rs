@@ -54,6 +54,7 @@ impl Memory {
     /// Memory at the end of normal loading: `C|x|` on the stick zone `[lo, hi]`, the end state
     /// elsewhere.
     pub fn after_normal_loading(state: Arc<ContactState>, slope: f64, lo: f64, hi: f64) -> Self {
+        let state = Arc::new(state.as_ref().clone().frozen());
         let outside = Arc::new(StrainSource::State { state });
         Self {
             pieces: vec![
@@ -79,6 +80,7 @@ impl Memory {
     /// Memory at the start of the next phase: `state`'s strain outside its stick zone
     /// `[lo, hi]`, the current memory inside.
     pub fn committed(&self, state: Arc<ContactState>, lo: f64, hi: f64) -> Self {
+        let state = Arc::new(state.as_ref().clone().frozen());
         let outside = Arc::new(StrainSource::State { state });
         let mut pieces = vec![Piece {
             lo: f64::NEG_INFINITY,

@@ -226,10 +226,110 @@ pub struct StickZone {
     /// Amplitude A of the kink part `A·k(u)` of q̃ (Pa), see [`kink_density`]; non-zero only
     /// for the normal-loading state, whose memory `C|x|` has a kink at the centre.
     pub kink: f64,
-    /// Correction inherited from the state that began the phase (its own zone lies inside
-    /// this one); it carries the exact square-root structure of the memory at old stick ends.
+    /// Correction inherited from the state that began the phase; it carries the exact
+    /// square-root structure of the memory at old stick ends (see [`Inherited`]).
     #[serde(skip)]
-    pub inherited: Option<std::sync::Arc<StickZone>>,
+    pub inherited: Option<std::sync::Arc<Inherited>>,
+}
+
+/// An earlier stick zone's correction carried into a new zone, faded out smoothly where the
+/// new zone ends inside it: `χ(x) q̃_E(x)` with `χ` rising from 0 at `ramp_lo.0` to 1 at
+/// `ramp_lo.1` and falling from 1 at `ramp_hi.0` to 0 at `ramp_hi.1` (C² quintic ramps).
+/// The memory inside the new zone has square-root kinks at the old zone's ends, which the old
+/// correction reproduces exactly; the fade only matters near the new ends, where q̃ must vanish.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Inherited {
+    /// The earlier zone (with its own chain).
+    pub zone: std::sync::Arc<StickZone>,
+    /// Left ramp `(start, end)`, or `None` when the earlier zone lies inside on that side.
+    pub ramp_lo: Option<(f64, f64)>,
+    /// Right ramp `(start, end)`.
+    pub ramp_hi: Option<(f64, f64)>,
+}
+
+fn smootherstep(v: f64) -> f64 {
+    let v = v.clamp(0.0, 1.0);
+    v * v * v * (v * (6.0 * v - 15.0) + 10.0)
+}
+
+impl Inherited {
+    /// The fade factor χ(x).
+    pub fn chi(&self, x: f64) -> f64 {
+        let up = self
+            .ramp_lo
+            .map_or(1.0, |(a, b)| smootherstep((x - a) / (b - a)));
+        let down = self
+            .ramp_hi
+            .map_or(1.0, |(a, b)| 1.0 - smootherstep((x - a) / (b - a)));
+        up * down
+    }
+
+    fn faded(&self) -> bool {
+        self.ramp_lo.is_some() || self.ramp_hi.is_some()
+    }
+
+    /// `χ q̃_E` at x.
+    pub fn value(&self, x: f64) -> f64 {
+        if self.faded() {
+            self.chi(x) * self.zone.correction_at(x)
+        } else {
+            self.zone.correction_at(x)
+        }
+    }
+
+    /// Breakpoints of the quadrature over the earlier zone.
+    fn pieces(&self) -> Vec<f64> {
+        let mut pts = vec![self.zone.lo];
+        for r in [self.ramp_lo, self.ramp_hi].into_iter().flatten() {
+            for v in [r.0, r.1] {
+                if v > self.zone.lo && v < self.zone.hi {
+                    pts.push(v);
+                }
+            }
+        }
+        pts.push(self.zone.hi);
+        pts.sort_by(f64::total_cmp);
+        pts
+    }
+
+    /// `H'(χ q̃_E)(x) = χ(x) H'q̃_E(x) + (1/π)∫ (χ(t) − χ(x)) q̃_E(t)/(t − x) dt`.
+    pub fn cauchy(&self, x: f64) -> f64 {
+        if !self.faded() {
+            return self.zone.correction_cauchy(x);
+        }
+        let cx = self.chi(x);
+        let (nodes, weights) = graded_rule();
+        let mut sum = 0.0;
+        for w in self.pieces().windows(2) {
+            let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+            for (u, wt) in nodes.iter().zip(weights) {
+                let t = mid + half * u;
+                if (t - x).abs() > 1e-14 * half.abs().max(1e-300) {
+                    sum += wt * half * (self.chi(t) - cx) * self.zone.correction_at(t) / (t - x);
+                }
+            }
+        }
+        cx * self.zone.correction_cauchy(x) + sum / std::f64::consts::PI
+    }
+
+    /// `∫ χ q̃_E dx`.
+    pub fn integral(&self) -> f64 {
+        if !self.faded() {
+            return self.zone.correction_integral();
+        }
+        let (nodes, weights) = graded_rule();
+        self.pieces()
+            .windows(2)
+            .map(|w| {
+                let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+                nodes
+                    .iter()
+                    .zip(weights)
+                    .map(|(u, wt)| wt * half * self.value(mid + half * u))
+                    .sum::<f64>()
+            })
+            .sum()
+    }
 }
 
 /// `k(u) = −(2u/π) artanh √(1 − u²)`: the bounded solution of
@@ -271,48 +371,73 @@ impl StickZone {
     pub fn correction_at(&self, x: f64) -> f64 {
         let u = (x - self.mid()) / self.half();
         let own = self.correction.density(u) + self.kink * kink_density(u);
-        own + self.inherited.as_ref().map_or(0.0, |z| z.correction_at(x))
+        own + self.inherited.as_ref().map_or(0.0, |z| z.value(x))
     }
 
     /// `H'q̃(x)` (Pa), including the inherited chain.
     pub fn correction_cauchy(&self, x: f64) -> f64 {
         let u = (x - self.mid()) / self.half();
         let own = self.correction.cauchy(u) + self.kink * kink_cauchy(u);
-        own + self
-            .inherited
-            .as_ref()
-            .map_or(0.0, |z| z.correction_cauchy(x))
+        own + self.inherited.as_ref().map_or(0.0, |z| z.cauchy(x))
     }
 
     /// `∫ q̃ dx` (N/m), including the inherited chain (the kink part is odd).
     pub fn correction_integral(&self) -> f64 {
         self.half() * self.correction.integral()
-            + self
-                .inherited
-                .as_ref()
-                .map_or(0.0, |z| z.correction_integral())
+            + self.inherited.as_ref().map_or(0.0, |z| z.integral())
     }
 
-    /// The outermost zone of this chain that lies inside `[lo, hi]`.
-    pub fn contained_in(
+    /// What a new zone `[lo, hi]` inherits from this chain. The memory inside the new zone
+    /// has square-root kinks exactly at the ends of earlier zones that lie inside it (and a
+    /// `|x|` kink at the centre of the normal-loading zone): the outermost earlier zone that
+    /// lies inside is inherited whole; one with a single end inside is inherited faded out
+    /// beyond the new zone's end; one that contains the new zone is passed over for its inner
+    /// zones, unless its own centre kink lies inside.
+    pub fn inheritance_for(
         self: &std::sync::Arc<Self>,
         lo: f64,
         hi: f64,
-    ) -> Option<std::sync::Arc<StickZone>> {
+    ) -> Option<std::sync::Arc<Inherited>> {
         let slack = 1e-12 * (hi - lo);
+        let inside = |x: f64| x > lo + slack && x < hi - slack;
         let mut zone = Some(self.clone());
         while let Some(z) = zone {
-            if z.lo >= lo - slack && z.hi <= hi + slack {
-                return Some(z);
+            let overlap = z.hi.min(hi) - z.lo.max(lo);
+            let ramp = 0.25 * overlap;
+            let candidate = if z.lo >= lo - slack && z.hi <= hi + slack {
+                Some(Inherited {
+                    zone: z.clone(),
+                    ramp_lo: None,
+                    ramp_hi: None,
+                })
+            } else if overlap >= 0.1 * (hi - lo) && (inside(z.lo) != inside(z.hi)) {
+                let ramp_lo = (!inside(z.lo)).then_some((lo, lo + ramp));
+                let ramp_hi = (!inside(z.hi)).then_some((hi - ramp, hi));
+                Some(Inherited {
+                    zone: z.clone(),
+                    ramp_lo,
+                    ramp_hi,
+                })
+            } else if z.kink.abs() > 0.0 && inside(z.mid()) && overlap >= 0.1 * (hi - lo) {
+                Some(Inherited {
+                    zone: z.clone(),
+                    ramp_lo: Some((lo, lo + ramp)),
+                    ramp_hi: Some((hi - ramp, hi)),
+                })
+            } else {
+                None
+            };
+            if let Some(c) = candidate {
+                return Some(std::sync::Arc::new(c));
             }
-            zone = z.inherited.clone();
+            zone = z.inherited.as_ref().map(|i| i.zone.clone());
         }
         None
     }
 
     /// Number of zones in the chain.
     pub fn chain_len(&self) -> usize {
-        1 + self.inherited.as_ref().map_or(0, |z| z.chain_len())
+        1 + self.inherited.as_ref().map_or(0, |z| z.zone.chain_len())
     }
 }
 
@@ -350,6 +475,10 @@ pub struct ContactState {
     pub potential_charge: UnboundedSeries,
     /// Shear traction.
     pub traction: Traction,
+    /// Quadrature table `(t, w p(t), S(t))` of [`ContactState::shape_cauchy`] for a stored
+    /// state whose slip zones have opposite signs (built by [`ContactState::frozen`]).
+    #[serde(skip)]
+    pub shape_table: Option<std::sync::Arc<Vec<(f64, f64, f64)>>>,
 }
 
 impl ContactState {
@@ -420,6 +549,14 @@ impl ContactState {
         let Some(stick) = &t.stick else { return 0.0 };
         let sx = self.slip_shape(x);
         let mut value = sx * self.pressure_cauchy(x);
+        if let Some(table) = &self.shape_table {
+            let sum: f64 = table
+                .iter()
+                .filter(|(tt, _, _)| (tt - x).abs() > 1e-14 * self.half_width)
+                .map(|(tt, wp, st)| wp * (st - sx) / (tt - x))
+                .sum();
+            return value + sum / std::f64::consts::PI;
+        }
         if (t.left_sign - t.right_sign).abs() > 0.0 {
             let ends = [
                 self.centre - self.half_width,
@@ -445,6 +582,31 @@ impl ContactState {
             value += sum / std::f64::consts::PI;
         }
         value
+    }
+
+    /// This state with the quadrature of [`Self::shape_cauchy`] tabulated, for states that
+    /// are stored and evaluated many times (the memory).
+    pub fn frozen(mut self) -> Self {
+        let t = &self.traction;
+        if let (Some(stick), true) = (&t.stick, (t.left_sign - t.right_sign).abs() > 0.0) {
+            let ends = [
+                self.centre - self.half_width,
+                stick.lo,
+                stick.hi,
+                self.centre + self.half_width,
+            ];
+            let (nodes, weights) = graded_rule();
+            let mut table = Vec::with_capacity(3 * nodes.len());
+            for seg in ends.windows(2) {
+                let (mid, half) = (0.5 * (seg[0] + seg[1]), 0.5 * (seg[1] - seg[0]));
+                for (u, w) in nodes.iter().zip(weights) {
+                    let tt = mid + half * u;
+                    table.push((tt, w * half * self.pressure_at(tt), self.slip_shape(tt)));
+                }
+            }
+            self.shape_table = Some(std::sync::Arc::new(table));
+        }
+        self
     }
 
     /// `H'q(x) = η H'(pS)(x) + H'q̃(x)` (Pa), on and off the contact.
