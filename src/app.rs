@@ -56,6 +56,10 @@ pub struct NormalSummary {
     pub iterations: usize,
     /// Worst admissibility violations.
     pub admissibility: crate::contact::normal::Admissibility,
+    /// The true gap just outside the contact ends.
+    pub outside_gap: crate::contact::GapReport,
+    /// Charge carried by the pressure, Γ1 = kP (C/m).
+    pub pressure_charge: f64,
 }
 
 /// `summary.json`.
@@ -104,7 +108,7 @@ pub fn field_points(centre: f64, half_width: f64, count: usize) -> Vec<f64> {
         .collect()
 }
 
-fn normal_summary(n: &NormalLoading) -> NormalSummary {
+fn normal_summary(model: &ContactModel, n: &NormalLoading) -> NormalSummary {
     let s = &n.state;
     let w_total = s.potential_charge.integral() * s.half_width;
     NormalSummary {
@@ -121,6 +125,8 @@ fn normal_summary(n: &NormalLoading) -> NormalSummary {
         charge_resultant: s.split.ratio * s.pressure.integral() * s.half_width + w_total,
         iterations: n.iterations,
         admissibility: n.admissibility,
+        outside_gap: model.outside_gap(s),
+        pressure_charge: model.pressure_charge(s.normal_load),
     }
 }
 
@@ -135,18 +141,20 @@ pub fn run(scenario: &Scenario, out_dir: &Path) -> Result<RunResult, Error> {
         })?;
     let mut warnings = Vec::new();
     let gamma1 = model.pressure_charge(scenario.normal_load);
-    if normal.state.split.conducting && normal.state.charge > gamma1 {
+    let gap = model.outside_gap(&normal.state);
+    if gap.min_gap < 0.0 {
         warnings.push(format!(
-            "Γ = {:.4e} C/m exceeds the charge carried by the pressure Γ1 = kP = {gamma1:.4e} C/m: the conducting-punch model \
-             (smooth pressure at the contact ends) implies a slightly negative gap just outside the contact",
-            normal.state.charge
+            "the surface interpenetrates the punch just outside the contact: gap {:.3e} m at x = {:.4e} m \
+             (a²/2R = {:.3e} m); Γ = {:.4e} C/m exceeds the charge carried by the pressure Γ1 = kP = {gamma1:.4e} C/m, \
+             and the conducting-punch model (smooth pressure at the contact ends) then admits no state with a non-negative gap",
+            gap.min_gap, gap.at, gap.scale, normal.state.charge
         ));
     }
     let summary = Summary {
         fretsim_version: env!("CARGO_PKG_VERSION"),
         scenario: scenario.raw.clone(),
         derived: derived(model, scenario.normal_load),
-        normal_loading: normal_summary(&normal),
+        normal_loading: normal_summary(model, &normal),
         warnings,
     };
     let points: Vec<SurfacePoint> = field_points(normal.state.centre, normal.state.half_width, 400)
@@ -189,4 +197,207 @@ pub fn run(scenario: &Scenario, out_dir: &Path) -> Result<RunResult, Error> {
             Err(e)
         }
     }
+}
+
+/// One varied field of a sweep: `path=start:end:count` (linear spacing, count ≥ 1).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Vary {
+    /// Dotted JSON path, e.g. `friction` or `punch.electrode.charge`.
+    pub path: String,
+    /// Values.
+    pub values: Vec<f64>,
+}
+
+impl std::str::FromStr for Vary {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (path, range) = s
+            .split_once('=')
+            .ok_or_else(|| format!("`{s}` must read FIELD=START:END:COUNT"))?;
+        let parts: Vec<&str> = range.split(':').collect();
+        let [start, end, count] = parts.as_slice() else {
+            return Err(format!("`{range}` must read START:END:COUNT"));
+        };
+        let start: f64 = start
+            .parse()
+            .map_err(|_| format!("START `{start}` is not a number"))?;
+        let end: f64 = end
+            .parse()
+            .map_err(|_| format!("END `{end}` is not a number"))?;
+        let count: usize = count
+            .parse()
+            .map_err(|_| format!("COUNT `{count}` is not a whole number"))?;
+        if count == 0 || !start.is_finite() || !end.is_finite() {
+            return Err("COUNT must be ≥ 1 and START, END finite".into());
+        }
+        let values = (0..count)
+            .map(|i| {
+                if count == 1 {
+                    start
+                } else {
+                    start + (end - start) * i as f64 / (count - 1) as f64
+                }
+            })
+            .collect();
+        Ok(Self {
+            path: path.to_string(),
+            values,
+        })
+    }
+}
+
+/// A shard of a sweep: run every N-th variant starting at I (1-based `I/N`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// I (1-based).
+    pub index: usize,
+    /// N.
+    pub count: usize,
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let (i, n) = s
+            .split_once('/')
+            .ok_or_else(|| format!("`{s}` must read I/N"))?;
+        let index: usize = i
+            .parse()
+            .map_err(|_| format!("I `{i}` is not a whole number"))?;
+        let count: usize = n
+            .parse()
+            .map_err(|_| format!("N `{n}` is not a whole number"))?;
+        if count == 0 || index == 0 || index > count {
+            return Err(format!("`{s}` needs 1 ≤ I ≤ N"));
+        }
+        Ok(Self { index, count })
+    }
+}
+
+fn set_path(value: &mut serde_json::Value, path: &str, x: f64) -> Result<(), String> {
+    let mut cur = value;
+    let keys: Vec<&str> = path.split('.').collect();
+    for (i, k) in keys.iter().enumerate() {
+        let obj = cur
+            .as_object_mut()
+            .ok_or_else(|| format!("`{path}`: `{}` is not an object", keys[..i].join(".")))?;
+        if i + 1 == keys.len() {
+            obj.insert((*k).to_string(), serde_json::json!(x));
+            return Ok(());
+        }
+        cur = obj
+            .entry((*k).to_string())
+            .or_insert_with(|| serde_json::json!({}));
+    }
+    Ok(())
+}
+
+/// Run the normal-loading solve for every variant of `text` (a scenario) over the Cartesian
+/// product of `vary`, in parallel, and return the CSV bytes of one row per variant.
+pub fn sweep(
+    text: &str,
+    source: &Path,
+    vary: &[Vary],
+    shard: Option<Shard>,
+) -> Result<Vec<u8>, Error> {
+    let base: serde_json::Value = serde_json::from_str(text).map_err(|e| Error::ParseScenario {
+        path: source.to_path_buf(),
+        at: String::new(),
+        line: e.line(),
+        column: e.column(),
+        message: e.to_string(),
+    })?;
+    // Cartesian product of the values.
+    let mut combos: Vec<Vec<f64>> = vec![Vec::new()];
+    for v in vary {
+        combos = combos
+            .into_iter()
+            .flat_map(|c| v.values.iter().map(move |x| [c.clone(), vec![*x]].concat()))
+            .collect();
+    }
+    let selected: Vec<(usize, Vec<f64>)> = combos
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| shard.is_none_or(|s| i % s.count == s.index - 1))
+        .collect();
+    // Validate every variant before solving any.
+    let mut scenarios = Vec::new();
+    let mut issues = Vec::new();
+    for (i, values) in &selected {
+        let mut v = base.clone();
+        for (var, x) in vary.iter().zip(values) {
+            set_path(&mut v, &var.path, *x).map_err(|m| Error::InvalidScenario {
+                path: source.to_path_buf(),
+                issues: vec![crate::error::Issue::new(var.path.clone(), m)],
+            })?;
+        }
+        let raw = crate::scenario::parse(&v.to_string(), source)?;
+        match crate::scenario::validate(raw) {
+            Ok(s) => scenarios.push((*i, values.clone(), s)),
+            Err(found) => issues.extend(found.into_iter().map(|mut is| {
+                is.message = format!("{} (variant {i})", is.message);
+                is
+            })),
+        }
+    }
+    if !issues.is_empty() {
+        return Err(Error::InvalidScenario {
+            path: source.to_path_buf(),
+            issues,
+        });
+    }
+    use rayon::prelude::*;
+    let rows: Vec<Vec<String>> = scenarios
+        .par_iter()
+        .map(|(i, values, sc)| {
+            let disc = Discretisation::new(sc.collocation_points);
+            let mut row = vec![i.to_string()];
+            row.extend(values.iter().map(|x| format!("{x:.12e}")));
+            match solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()) {
+                Ok(n) => {
+                    let s = &n.state;
+                    row.extend(
+                        [
+                            s.half_width,
+                            n.stick_half_width / s.half_width,
+                            n.strain_slope,
+                            s.pressure_at(s.centre),
+                            s.charge,
+                            s.potential.unwrap_or(f64::NAN),
+                            s.traction.right_sign,
+                        ]
+                        .iter()
+                        .map(|x| format!("{x:.10e}")),
+                    );
+                    row.push(String::new());
+                }
+                Err(e) => {
+                    row.extend(std::iter::repeat_n("NaN".to_string(), 7));
+                    row.push(e.to_string());
+                }
+            }
+            row
+        })
+        .collect();
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header = vec!["variant".to_string()];
+    header.extend(vary.iter().map(|v| v.path.clone()));
+    header.extend(
+        [
+            "a_m",
+            "b_over_a",
+            "C_per_m",
+            "p0_Pa",
+            "charge_C_per_m",
+            "potential_V",
+            "slip_sign_right",
+            "error",
+        ]
+        .map(String::from),
+    );
+    w.write_record(&header).expect("in-memory write");
+    for r in rows {
+        w.write_record(&r).expect("in-memory write");
+    }
+    Ok(w.into_inner().expect("in-memory write"))
 }

@@ -27,6 +27,21 @@ pub enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Normal-loading sweep over scenario fields (e.g. b/a and C against η, the seed paper's
+    /// Figures 8–9): one CSV row per variant, variants solved in parallel.
+    Sweep {
+        /// Scenario file (JSON).
+        scenario: PathBuf,
+        /// `FIELD=START:END:COUNT` (repeatable; the Cartesian product is run).
+        #[arg(long, required = true)]
+        vary: Vec<crate::app::Vary>,
+        /// Output folder (default: output/<scenario name>-sweep).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Run only every N-th variant starting at I (`I/N`), for array jobs.
+        #[arg(long)]
+        shard: Option<crate::app::Shard>,
+    },
     /// Validate a scenario file without solving.
     Check {
         /// Scenario file (JSON).

@@ -50,6 +50,28 @@ fn dispatch(command: Command) -> Result<(), Error> {
             }
             Ok(())
         }
+        Command::Sweep {
+            scenario: path,
+            vary,
+            out,
+            shard,
+        } => {
+            let sc = scenario::load(&path)?;
+            let text = std::fs::read_to_string(&path).map_err(|source| Error::ReadScenario {
+                path: path.clone(),
+                source,
+            })?;
+            let bytes = app::sweep(&text, &path, &vary, shard)?;
+            let out =
+                out.unwrap_or_else(|| PathBuf::from("output").join(format!("{}-sweep", sc.name)));
+            let name = match shard {
+                Some(s) => format!("sweep-{}-of-{}.csv", s.index, s.count),
+                None => "sweep.csv".to_string(),
+            };
+            fretsim::output::write_atomic(&out.join(&name), &bytes)?;
+            println!("{} -> {}", path.display(), out.join(name).display());
+            Ok(())
+        }
         Command::Check { scenario: path } => {
             let sc = scenario::load(&path)?;
             println!("{}: valid ({})", path.display(), sc.name);

@@ -683,3 +683,60 @@ impl ContactModel {
         }
     }
 }
+
+/// The true gap just outside the contact ends (seed model check, formulation §7).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GapReport {
+    /// Smallest gap found within one half-width outside either end (m); negative means the
+    /// surface interpenetrates the punch.
+    pub min_gap: f64,
+    /// Where (m).
+    pub at: f64,
+    /// The Hertzian scale `a²/(2R)` (m), for comparison.
+    pub scale: f64,
+}
+
+impl ContactModel {
+    /// Gap `g(x) = uz(x) − (δ0 − x²/(2R))` outside the contact, from
+    /// `g' = w12 q + y22 H'p + y23 H'g + x/R` (eq. B; q = 0 outside) integrated from each contact
+    /// end with `x = end ± v²` (which absorbs the inverse square root of a conducting punch's
+    /// charge), sampled at 60 points, clustered quadratically towards the end, up to one
+    /// half-width away.
+    pub fn outside_gap(&self, state: &ContactState) -> GapReport {
+        let y23 = self.compliance.electric.map_or(0.0, |e| e.y23);
+        let slope = |x: f64| {
+            self.compliance.y22 * state.pressure_cauchy(x)
+                + y23 * state.charge_cauchy(x)
+                + x / self.radius
+        };
+        let (c, a) = (state.centre, state.half_width);
+        let (nodes, weights) = crate::quadrature::gauss_legendre(64);
+        let mut report = GapReport {
+            min_gap: f64::INFINITY,
+            at: f64::NAN,
+            scale: a * a / (2.0 * self.radius),
+        };
+        for dir in [1.0, -1.0] {
+            let end = c + dir * a;
+            for k in 1..=60 {
+                let reach = a * (k as f64 / 60.0).powi(2);
+                let vmax = reach.sqrt();
+                // ∫_0^{vmax} g'(end + dir v²) 2v dv · dir
+                let gap: f64 = nodes
+                    .iter()
+                    .zip(&weights)
+                    .map(|(u, w)| {
+                        let v = 0.5 * vmax * (u + 1.0);
+                        0.5 * vmax * w * slope(end + dir * v * v) * 2.0 * v
+                    })
+                    .sum::<f64>()
+                    * dir;
+                if gap < report.min_gap {
+                    report.min_gap = gap;
+                    report.at = end + dir * reach;
+                }
+            }
+        }
+        report
+    }
+}

@@ -24,6 +24,8 @@ struct Normal {
     charge_resultant: f64,
     iterations: usize,
     admissibility: serde_json::Value,
+    outside_gap: serde_json::Value,
+    pressure_charge: f64,
 }
 
 #[derive(Debug, Deserialize)]
@@ -98,6 +100,8 @@ fn default_run_reports_the_paper_baseline_and_the_interpenetration_warning() {
     let s = read_summary(&out);
     assert_eq!(s.scenario["name"], "baseline");
     assert!(s.warnings.iter().any(|w| w.contains("Γ1")));
+    assert!(s.normal_loading.outside_gap["min_gap"].as_f64().unwrap() < 0.0);
+    assert!(s.normal_loading.pressure_charge > 4.9e-7 && s.normal_loading.pressure_charge < 5.1e-7);
 }
 
 #[test]
@@ -153,4 +157,47 @@ fn rerun_replaces_stale_files() {
     );
     assert!(!out.join("stale.csv").exists());
     assert!(out.join("summary.json").exists());
+}
+
+#[test]
+fn sweep_writes_one_row_per_variant_and_shards_split_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/baseline.json");
+    let out = tmp.path().join("sw");
+    let run = |extra: &[&str]| {
+        let mut cmd = fretsim();
+        cmd.arg("sweep")
+            .arg(&scenario)
+            .args(["--vary", "friction=0.2:0.8:4", "--out"])
+            .arg(&out)
+            .args(extra);
+        assert!(cmd.status().unwrap().success());
+    };
+    run(&[]);
+    let all = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let lines: Vec<&str> = all.lines().collect();
+    assert_eq!(lines.len(), 5);
+    assert!(lines[0].starts_with("variant,friction,a_m,b_over_a,C_per_m"));
+    // b/a rises with η (seed Figure 8).
+    let ratios: Vec<f64> = lines[1..]
+        .iter()
+        .map(|l| l.split(',').nth(3).unwrap().parse().unwrap())
+        .collect();
+    assert!(ratios.windows(2).all(|w| w[1] > w[0]), "{ratios:?}");
+    run(&["--shard", "2/2"]);
+    let shard = std::fs::read_to_string(out.join("sweep-2-of-2.csv")).unwrap();
+    assert_eq!(shard.lines().count(), 3);
+    assert!(
+        out.join("sweep.csv").exists(),
+        "a shard must not remove other files"
+    );
+    let bad = fretsim()
+        .arg("sweep")
+        .arg(&scenario)
+        .args(["--vary", "friction=-1:0.5:2", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("friction"));
 }

@@ -451,3 +451,54 @@ impl fretsim::history::Observer for Recorder {
         self.states.push(s.clone());
     }
 }
+
+/// The gap outside a Hertz contact, `g = (a²/2R)[ξ√(ξ² − 1) − ln(ξ + √(ξ² − 1))]`, ξ = x/a,
+/// is positive; under the conducting punch with Γ > Γ1 = kP the smooth-pressure model leaves a
+/// small negative gap just outside the ends (formulation notes: about −7e−11 m for the
+/// baseline), and with Γ < Γ1 none.
+#[test]
+fn reference_gap_outside_the_contact() {
+    let model = ContactModel::new(Material::Elastic(ALUMINIUM), 10e-3, 0.0, Electrode::None);
+    let s = solve_frictionless(&model, &Discretisation::new(32), 2.24e3).unwrap();
+    let g = model.outside_gap(&s);
+    let a = s.half_width;
+    let xi: f64 = 2.0;
+    let exact =
+        a * a / (2.0 * 10e-3) * (xi * (xi * xi - 1.0).sqrt() - (xi + (xi * xi - 1.0).sqrt()).ln());
+    assert!(g.min_gap > 0.0);
+    // The closed form at x = 2a, integrating the same slope as `outside_gap`.
+    let (nodes, weights) = fretsim::quadrature::gauss_legendre(64);
+    let vmax = a.sqrt();
+    let numeric: f64 = nodes
+        .iter()
+        .zip(&weights)
+        .map(|(u, w)| {
+            let v = 0.5 * vmax * (u + 1.0);
+            let x = a + v * v;
+            let slope = model.compliance.y22 * s.pressure_cauchy(x) + x / 10e-3;
+            0.5 * vmax * w * slope * 2.0 * v
+        })
+        .sum();
+    assert_relative_eq!(numeric, exact, max_relative = 1e-10);
+    for (gamma, negative) in [(6e-7, true), (3e-7, false)] {
+        let m = ContactModel::new(
+            Material::Piezoelectric(PZT4),
+            60e-3,
+            0.0,
+            Electrode::ConductingCharge { charge: gamma },
+        );
+        let s = solve_frictionless(&m, &Discretisation::new(64), 2000.0).unwrap();
+        let g = m.outside_gap(&s);
+        eprintln!(
+            "Γ = {gamma:e}: min gap {:.3e} m at x/a = {:.3}, a²/2R = {:.3e} m",
+            g.min_gap,
+            g.at / s.half_width,
+            g.scale
+        );
+        assert_eq!(g.min_gap < 0.0, negative, "Γ = {gamma:e}");
+        if negative {
+            // The formulation notes' independent estimate: about −7e−11 m (measured −7.12e−11).
+            assert!((g.min_gap + 7e-11).abs() < 0.5e-11, "{:e}", g.min_gap);
+        }
+    }
+}
