@@ -262,6 +262,8 @@ pub struct DriverState {
     history: Vec<(f64, f64, f64)>,
     /// Stick zone (with its correction chain) of the state that began the phase.
     base: Option<Arc<crate::contact::StickZone>>,
+    /// Tangential load at the start of the phase (N/m).
+    phase_start_load: f64,
 }
 
 impl DriverState {
@@ -279,6 +281,7 @@ impl DriverState {
             phase: 0,
             history: Vec::new(),
             base,
+            phase_start_load: 0.0,
         }
     }
 }
@@ -369,6 +372,12 @@ pub fn advance(
     } else {
         driver.base.clone()
     };
+    // Second guess: the Mindlin–Deresiewicz size for the load change since the phase began,
+    // centred on the contact.
+    let start_load = if new_phase { driver.state.tangential_load } else { driver.phase_start_load };
+    let (c, a) = (driver.state.centre, driver.state.half_width);
+    let md = (1.0 - ((q - start_load).abs() / (2.0 * model.friction * driver.state.normal_load)).min(0.95)).sqrt();
+    let guesses = [guess, (c - a * md, c + a * md)];
     let solved: SlipStep = solve_slip(
         model,
         disc,
@@ -377,7 +386,7 @@ pub fn advance(
         &driver.state,
         q,
         sign,
-        guess,
+        &guesses,
         options,
     )
     .map_err(|failure| StepFailure {
@@ -389,6 +398,7 @@ pub fn advance(
     })?;
     if new_phase {
         driver.phase += 1;
+        driver.phase_start_load = start_load;
         driver.phase_sign = Some(sign);
         driver.memory = memory;
         driver.base = base;

@@ -325,7 +325,7 @@ fn solve4(mut j: [[f64; 4]; 4], r: [f64; 4]) -> Option<[f64; 4]> {
 }
 
 /// Solve one step at tangential load `tangential_load` with slip sign `sign`, starting from
-/// `start` (the previous step), the stick-zone guess `guess` and the phase's inherited
+/// `start` (the previous step), stick-zone guesses tried in turn and the phase's inherited
 /// correction chain `base`.
 #[allow(clippy::too_many_arguments)]
 pub fn solve_slip(
@@ -336,9 +336,10 @@ pub fn solve_slip(
     start: &ContactState,
     tangential_load: f64,
     sign: f64,
-    guess: (f64, f64),
+    guesses_in: &[(f64, f64)],
     options: SlipOptions,
 ) -> Result<SlipStep, SolveFailure> {
+    let guess = guesses_in[0];
     // Both slip zones normally follow the load (seed Section 4); right after a reversal in a
     // coupled contact one edge may keep its previous direction while the contact shifts, so
     // the mixed states are tried when the standard one has no solution.
@@ -354,11 +355,10 @@ pub fn solve_slip(
         .into_iter()
         .filter(|&x| x > guess.0.min(c - a) - a && x < guess.1.max(c + a) + a)
         .collect();
-    let mut guesses = vec![guess];
-    let no_breaks = std::env::var("FRETSIM_NOBREAKS").is_ok();
+    let mut guesses = guesses_in.to_vec();
     for i in 0..breaks.len() / 2 {
         let (l, r) = (breaks[i], breaks[breaks.len() - 1 - i]);
-        if !no_breaks && r - l > 2.0 * inset && l > c - a && r < c + a {
+        if r - l > 2.0 * inset && l > c - a && r < c + a {
             guesses.push((l + inset, r - inset));
         }
     }
