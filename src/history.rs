@@ -374,9 +374,15 @@ pub fn advance(
     };
     // Second guess: the Mindlin–Deresiewicz size for the load change since the phase began,
     // centred on the contact.
-    let start_load = if new_phase { driver.state.tangential_load } else { driver.phase_start_load };
+    let start_load = if new_phase {
+        driver.state.tangential_load
+    } else {
+        driver.phase_start_load
+    };
     let (c, a) = (driver.state.centre, driver.state.half_width);
-    let md = (1.0 - ((q - start_load).abs() / (2.0 * model.friction * driver.state.normal_load)).min(0.95)).sqrt();
+    let md = (1.0
+        - ((q - start_load).abs() / (2.0 * model.friction * driver.state.normal_load)).min(0.95))
+    .sqrt();
     let guesses = [guess, (c - a * md, c + a * md)];
     let solved: SlipStep = solve_slip(
         model,

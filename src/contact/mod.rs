@@ -237,7 +237,7 @@ pub struct StickZone {
 /// `ramp_lo.1` and falling from 1 at `ramp_hi.0` to 0 at `ramp_hi.1` (C² quintic ramps).
 /// The memory inside the new zone has square-root kinks at the old zone's ends, which the old
 /// correction reproduces exactly; the fade only matters near the new ends, where q̃ must vanish.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Inherited {
     /// The earlier zone (with its own chain).
     pub zone: std::sync::Arc<StickZone>,
@@ -245,6 +245,14 @@ pub struct Inherited {
     pub ramp_lo: Option<(f64, f64)>,
     /// Right ramp `(start, end)`.
     pub ramp_hi: Option<(f64, f64)>,
+    /// Quadrature table `(t, w q̃_E(t), χ(t))` of the fade integral, built on first use.
+    table: std::sync::OnceLock<Vec<(f64, f64, f64)>>,
+}
+
+impl PartialEq for Inherited {
+    fn eq(&self, other: &Self) -> bool {
+        self.zone == other.zone && self.ramp_lo == other.ramp_lo && self.ramp_hi == other.ramp_hi
+    }
 }
 
 fn smootherstep(v: f64) -> f64 {
@@ -253,6 +261,35 @@ fn smootherstep(v: f64) -> f64 {
 }
 
 impl Inherited {
+    /// The earlier zone carried whole or faded by the given ramps.
+    pub fn new(
+        zone: std::sync::Arc<StickZone>,
+        ramp_lo: Option<(f64, f64)>,
+        ramp_hi: Option<(f64, f64)>,
+    ) -> Self {
+        Self {
+            zone,
+            ramp_lo,
+            ramp_hi,
+            table: std::sync::OnceLock::new(),
+        }
+    }
+
+    fn table(&self) -> &[(f64, f64, f64)] {
+        self.table.get_or_init(|| {
+            let (nodes, weights) = graded_rule();
+            let mut out = Vec::new();
+            for w in self.pieces().windows(2) {
+                let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+                for (u, wt) in nodes.iter().zip(weights) {
+                    let t = mid + half * u;
+                    out.push((t, wt * half * self.zone.correction_at(t), self.chi(t)));
+                }
+            }
+            out
+        })
+    }
+
     /// The fade factor χ(x).
     pub fn chi(&self, x: f64) -> f64 {
         let up = self
@@ -298,17 +335,13 @@ impl Inherited {
             return self.zone.correction_cauchy(x);
         }
         let cx = self.chi(x);
-        let (nodes, weights) = graded_rule();
-        let mut sum = 0.0;
-        for w in self.pieces().windows(2) {
-            let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-            for (u, wt) in nodes.iter().zip(weights) {
-                let t = mid + half * u;
-                if (t - x).abs() > 1e-14 * half.abs().max(1e-300) {
-                    sum += wt * half * (self.chi(t) - cx) * self.zone.correction_at(t) / (t - x);
-                }
-            }
-        }
+        let tiny = 1e-14 * (self.zone.hi - self.zone.lo);
+        let sum: f64 = self
+            .table()
+            .iter()
+            .filter(|(t, _, _)| (t - x).abs() > tiny)
+            .map(|(t, wq, chi)| wq * (chi - cx) / (t - x))
+            .sum();
         cx * self.zone.correction_cauchy(x) + sum / std::f64::consts::PI
     }
 
@@ -405,25 +438,17 @@ impl StickZone {
             let overlap = z.hi.min(hi) - z.lo.max(lo);
             let ramp = 0.25 * overlap;
             let candidate = if z.lo >= lo - slack && z.hi <= hi + slack {
-                Some(Inherited {
-                    zone: z.clone(),
-                    ramp_lo: None,
-                    ramp_hi: None,
-                })
+                Some(Inherited::new(z.clone(), None, None))
             } else if overlap >= 0.1 * (hi - lo) && (inside(z.lo) != inside(z.hi)) {
                 let ramp_lo = (!inside(z.lo)).then_some((lo, lo + ramp));
                 let ramp_hi = (!inside(z.hi)).then_some((hi - ramp, hi));
-                Some(Inherited {
-                    zone: z.clone(),
-                    ramp_lo,
-                    ramp_hi,
-                })
+                Some(Inherited::new(z.clone(), ramp_lo, ramp_hi))
             } else if z.kink.abs() > 0.0 && inside(z.mid()) && overlap >= 0.1 * (hi - lo) {
-                Some(Inherited {
-                    zone: z.clone(),
-                    ramp_lo: Some((lo, lo + ramp)),
-                    ramp_hi: Some((hi - ramp, hi)),
-                })
+                Some(Inherited::new(
+                    z.clone(),
+                    Some((lo, lo + ramp)),
+                    Some((hi - ramp, hi)),
+                ))
             } else {
                 None
             };
@@ -587,6 +612,14 @@ impl ContactState {
     /// This state with the quadrature of [`Self::shape_cauchy`] tabulated, for states that
     /// are stored and evaluated many times (the memory).
     pub fn frozen(mut self) -> Self {
+        self.tabulate_shape();
+        self
+    }
+
+    /// (Re)build the shape quadrature table for the current pressure and stick zone (no-op
+    /// when both slip zones have the same sign).
+    pub fn tabulate_shape(&mut self) {
+        self.shape_table = None;
         let t = &self.traction;
         if let (Some(stick), true) = (&t.stick, (t.left_sign - t.right_sign).abs() > 0.0) {
             let ends = [
@@ -606,7 +639,6 @@ impl ContactState {
             }
             self.shape_table = Some(std::sync::Arc::new(table));
         }
-        self
     }
 
     /// `H'q(x) = η H'(pS)(x) + H'q̃(x)` (Pa), on and off the contact.

@@ -143,6 +143,10 @@ impl StepProblem<'_> {
         let eta = model.friction;
         let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
         let local = model.local_pressure_strain(split);
+        let potential_control = matches!(
+            model.electrode,
+            super::Electrode::ConductingPotential { .. }
+        );
         let (mid, half) = (0.5 * (g.lo + g.hi), 0.5 * (g.hi - g.lo));
         let stick_points: Vec<f64> = disc
             .bounded
@@ -199,13 +203,19 @@ impl StepProblem<'_> {
             }
             lambda_p = disc.bounded.solve(&rhs, &mut psi);
             state.pressure = BoundedSeries::from_nodes(&disc.bounded, &psi);
-            // Charge (seed eqs. 53, 55, 41–42) for the current shear traction.
+            // Charge (seed eqs. 53, 55, 41–42) for the current shear traction. The arcsine
+            // moment of q fixes Γ under potential control; under charge control it only gives
+            // φ0 and is evaluated once for the accepted state.
             if split.conducting {
                 let e = model
                     .compliance
                     .electric
                     .expect("conducting punch on a piezoelectric half-plane");
-                let j_q = arcsine_moment(&state);
+                let j_q = if potential_control {
+                    arcsine_moment(&state)
+                } else {
+                    0.0
+                };
                 let (charge, potential) = electric_resultants(model, g.a, self.normal_load, j_q);
                 state.charge = charge;
                 state.potential = potential;
@@ -217,6 +227,7 @@ impl StepProblem<'_> {
             // Stick traction (seed eqs. 50–51/58–59, 60, 63); `H'(pS)` is `s H'p` when both slip
             // zones have the sign s.
             state.traction.stick = Some(StickZone::new(g.lo, g.hi, BoundedSeries::default(), 0.0));
+            state.tabulate_shape();
             let srhs: Vec<f64> = stick_points
                 .iter()
                 .zip(&fixed)
@@ -260,6 +271,7 @@ impl StepProblem<'_> {
                 break;
             }
         }
+        state.shape_table = None;
         let p0 = state.pressure_at(g.c).abs().max(1e-300);
         let pressure_force = g.a * state.pressure.integral();
         let stick = state.traction.stick.as_ref().expect("set above");
@@ -414,6 +426,18 @@ fn solve_geometry(
             eprintln!("newton {iter}: {:?} r {:?}", g, r);
         }
         if size < options.tolerance {
+            if state.split.conducting
+                && !matches!(
+                    model.electrode,
+                    super::Electrode::ConductingPotential { .. }
+                )
+            {
+                // φ0 of the accepted state (charge control; the moment does not feed back).
+                let j_q = arcsine_moment(&state);
+                let (charge, potential) = electric_resultants(model, g.a, problem.normal_load, j_q);
+                state.charge = charge;
+                state.potential = potential;
+            }
             let admissibility = assess_step(model, start, &state);
             check(&admissibility, &state, options.admissibility)?;
             return Ok(SlipStep {
