@@ -6,6 +6,7 @@ use serde::Serialize;
 
 use crate::contact::normal::{NormalLoading, NormalOptions, solve_normal};
 use crate::contact::pressure::Discretisation;
+use crate::contact::tangential::SlipOptions;
 use crate::contact::{ContactModel, SurfacePoint};
 use crate::error::Error;
 use crate::halfplane::{PaperCoefficients, SurfaceCompliance, SurfaceFieldCoefficients};
@@ -73,6 +74,8 @@ pub struct Summary {
     pub derived: Derived,
     /// Normal-loading results.
     pub normal_loading: NormalSummary,
+    /// Tangential history results (absent without a history).
+    pub history: Option<HistorySummary>,
     /// Warnings.
     pub warnings: Vec<String>,
 }
@@ -132,6 +135,28 @@ fn normal_summary(model: &ContactModel, n: &NormalLoading) -> NormalSummary {
 
 /// Solve a validated scenario and write its outputs into `out_dir` (replacing it).
 pub fn run(scenario: &Scenario, out_dir: &Path) -> Result<RunResult, Error> {
+    run_with(scenario, out_dir, &mut crate::history::NoObserver)
+}
+
+/// Summary of the tangential history, in `summary.json`.
+#[derive(Debug, Serialize)]
+pub struct HistorySummary {
+    /// Number of accepted steps after normal loading.
+    pub steps: usize,
+    /// Number of phases (monotonic segments between reversals).
+    pub phases: usize,
+    /// The states at the end of each phase: step, Q, stick ends, eccentricity.
+    pub turning_points: Vec<crate::history::StepRecord>,
+    /// The failure, if the run stopped early.
+    pub failure: Option<String>,
+}
+
+/// As [`run`], reporting each accepted step to `observer` (progress bars).
+pub fn run_with(
+    scenario: &Scenario,
+    out_dir: &Path,
+    observer: &mut dyn crate::history::Observer,
+) -> Result<RunResult, Error> {
     let model = &scenario.model;
     let disc = Discretisation::new(scenario.collocation_points);
     let normal = solve_normal(model, &disc, scenario.normal_load, NormalOptions::default())
@@ -150,11 +175,49 @@ pub fn run(scenario: &Scenario, out_dir: &Path) -> Result<RunResult, Error> {
             gap.min_gap, gap.at, gap.scale, normal.state.charge
         ));
     }
+    // The tangential history, if any; a failure keeps the steps already solved.
+    let mut records = Vec::new();
+    let mut failure = None;
+    if let Some(history) = &scenario.history {
+        match crate::history::run_history(
+            model,
+            &disc,
+            &normal,
+            history,
+            SlipOptions::default(),
+            observer,
+        ) {
+            Ok(run) => records = run.records,
+            Err(f) => {
+                let f = *f;
+                records = f.records;
+                failure = Some(Error::Solve {
+                    context: f.failure.to_string(),
+                    failure: f.failure.failure,
+                });
+            }
+        }
+    }
+    let history_summary = scenario.history.as_ref().map(|_| {
+        let turning_points = records
+            .windows(2)
+            .filter(|w| w[0].phase != w[1].phase && w[0].phase > 0)
+            .map(|w| w[0].clone())
+            .chain(records.last().filter(|r| r.phase > 0).cloned())
+            .collect();
+        HistorySummary {
+            steps: records.len().saturating_sub(1),
+            phases: records.last().map_or(0, |r| r.phase),
+            turning_points,
+            failure: failure.as_ref().map(|e| e.to_string()),
+        }
+    });
     let summary = Summary {
         fretsim_version: env!("CARGO_PKG_VERSION"),
         scenario: scenario.raw.clone(),
         derived: derived(model, scenario.normal_load),
         normal_loading: normal_summary(model, &normal),
+        history: history_summary,
         warnings,
     };
     let points: Vec<SurfacePoint> = field_points(normal.state.centre, normal.state.half_width, 400)
@@ -185,18 +248,90 @@ pub fn run(scenario: &Scenario, out_dir: &Path) -> Result<RunResult, Error> {
                 &rows,
             ),
         )?;
+        if scenario.history.is_some() {
+            staging.write(
+                "steps.csv",
+                &steps_csv(&records, model.friction * scenario.normal_load),
+            )?;
+        }
+        if let Some(e) = &failure {
+            let body = serde_json::json!({
+                "error": e.to_string(),
+                "last_accepted_step": records.last(),
+            });
+            staging.write(
+                "failure.json",
+                &serde_json::to_vec_pretty(&body).expect("serialises"),
+            )?;
+        }
         Ok::<(), Error>(())
     })();
     match result {
-        Ok(()) => Ok(RunResult {
-            out_dir: staging.commit()?,
-            summary,
-        }),
+        Ok(()) => {
+            let out_dir = staging.commit()?;
+            match failure {
+                Some(e) => Err(e),
+                None => Ok(RunResult { out_dir, summary }),
+            }
+        }
         Err(e) => {
             staging.abandon();
             Err(e)
         }
     }
+}
+
+/// `steps.csv`: one row per accepted step.
+fn steps_csv(records: &[crate::history::StepRecord], limit: f64) -> Vec<u8> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record([
+        "step",
+        "t_s",
+        "Q_N_per_m",
+        "Q_over_etaP",
+        "regime",
+        "phase",
+        "a_m",
+        "e_m",
+        "stick_lo_m",
+        "stick_hi_m",
+        "left_slip_sign",
+        "right_slip_sign",
+        "newton_iterations",
+        "evaluations",
+        "residual",
+        "stick_excess",
+        "slip_reversal",
+    ])
+    .expect("in-memory write");
+    for r in records {
+        let regime = serde_json::to_value(r.regime)
+            .ok()
+            .and_then(|v| v.as_str().map(String::from))
+            .unwrap_or_default();
+        let f = |x: f64| format!("{x:.10e}");
+        w.write_record([
+            r.step.to_string(),
+            f(r.t),
+            f(r.q),
+            f(r.q / limit),
+            regime,
+            r.phase.to_string(),
+            f(r.half_width),
+            f(r.eccentricity),
+            f(r.stick_lo),
+            f(r.stick_hi),
+            f(r.left_slip_sign),
+            f(r.right_slip_sign),
+            r.iterations.to_string(),
+            r.newton_iterations.to_string(),
+            f(r.residual),
+            f(r.admissibility.stick_excess),
+            f(r.admissibility.slip_reversal),
+        ])
+        .expect("in-memory write");
+    }
+    w.into_inner().expect("in-memory write")
 }
 
 /// One varied field of a sweep: `path=start:end:count` (linear spacing, count ≥ 1).

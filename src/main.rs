@@ -20,6 +20,43 @@ fn main() -> ExitCode {
     }
 }
 
+/// Progress bar over the load steps (hidden with --quiet or when stderr is not a terminal).
+struct Progress(Option<indicatif::ProgressBar>);
+
+impl Progress {
+    fn new(total: u64, quiet: bool) -> Self {
+        use std::io::IsTerminal;
+        if quiet || total == 0 || !std::io::stderr().is_terminal() {
+            return Self(None);
+        }
+        let bar = indicatif::ProgressBar::new(total);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps {msg}")
+                .expect("valid template"),
+        );
+        Self(Some(bar))
+    }
+
+    fn finish(&self) {
+        if let Some(b) = &self.0 {
+            b.finish_and_clear();
+        }
+    }
+}
+
+impl fretsim::history::Observer for Progress {
+    fn on_step(
+        &mut self,
+        record: &fretsim::history::StepRecord,
+        _: &fretsim::contact::ContactState,
+    ) {
+        if let (Some(b), true) = (&self.0, record.step > 0) {
+            b.set_position(record.step as u64);
+            b.set_message(format!("Q = {:.1} N/m", record.q));
+        }
+    }
+}
+
 fn dispatch(command: Command) -> Result<(), Error> {
     match command {
         Command::Run {
@@ -32,7 +69,11 @@ fn dispatch(command: Command) -> Result<(), Error> {
                 None => scenario::default_scenario(),
             };
             let out = out.unwrap_or_else(|| PathBuf::from("output").join(&sc.name));
-            let result = app::run(&sc, &out)?;
+            let total = sc.history.as_ref().map_or(0, |h| h.steps().len() as u64);
+            let mut progress = Progress::new(total, quiet);
+            let result = app::run_with(&sc, &out, &mut progress);
+            progress.finish();
+            let result = result?;
             if !quiet {
                 let n = &result.summary.normal_loading;
                 println!(

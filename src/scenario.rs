@@ -35,6 +35,52 @@ pub struct RawScenario {
     /// Numerical settings.
     #[serde(default)]
     pub numerics: RawNumerics,
+    /// Tangential load history after normal loading (optional).
+    #[serde(default)]
+    pub tangential_history: Option<RawHistory>,
+}
+
+/// Unit of the tangential loads in a history.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum LoadUnit {
+    /// Q as a fraction of ηP (default).
+    #[default]
+    FractionOfLimit,
+    /// Q in N/m.
+    NewtonPerMetre,
+}
+
+/// A piecewise-linear Q(t): `points` (lead-in, from Q = 0 at the end of normal loading),
+/// then `cycle` repeated `repeats` times (cycle times relative to the start of each repeat).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawHistory {
+    /// Unit of Q and of `max_step`.
+    #[serde(default)]
+    pub unit: LoadUnit,
+    /// `[t (s), Q]` points.
+    pub points: Vec<(f64, f64)>,
+    /// `[Δt (s), Q]` points of a repeated block.
+    #[serde(default)]
+    pub cycle: Vec<(f64, f64)>,
+    /// Number of repeats of `cycle` (≥ 0, default 1).
+    #[serde(default = "default_repeats")]
+    pub repeats: usize,
+    /// Minimum number of load steps per segment (≥ 1, default 10).
+    #[serde(default = "default_steps")]
+    pub steps_per_segment: usize,
+    /// Largest load step, in the unit of Q (> 0, default 0.05 ηP).
+    #[serde(default)]
+    pub max_step: Option<f64>,
+}
+
+fn default_repeats() -> usize {
+    1
+}
+
+fn default_steps() -> usize {
+    10
 }
 
 fn default_name() -> String {
@@ -132,18 +178,26 @@ pub struct Scenario {
     pub normal_load: f64,
     /// M.
     pub collocation_points: usize,
+    /// The tangential load history in N/m, if any.
+    pub history: Option<crate::history::LoadHistory>,
     /// The input as read, echoed in the outputs.
     pub raw: RawScenario,
 }
 
 /// The built-in default: the seed paper's baseline (PZT-4, conducting punch, R = 60 mm,
-/// P = 2000 N/m, Γ = 6e−7 C/m, η = 0.3).
+/// P = 2000 N/m, Γ = 6e−7 C/m, η = 0.3), normal loading then three cycles of ±0.5 ηP.
 pub const DEFAULT_SCENARIO: &str = r#"{
   "name": "baseline",
   "material": { "kind": "preset", "name": "pzt4" },
   "punch": { "radius": 0.06, "electrode": { "kind": "conducting", "charge": 6e-7 } },
   "friction": 0.3,
-  "normal_load": 2000.0
+  "normal_load": 2000.0,
+  "tangential_history": {
+    "unit": "fraction_of_limit",
+    "points": [[0.0, 0.0], [1.0, 0.5]],
+    "cycle": [[2.0, -0.5], [4.0, 0.5]],
+    "repeats": 3
+  }
 }"#;
 
 /// Parse a scenario from JSON text; `path` names the source in messages.
@@ -315,6 +369,53 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
         },
         (RawElectrode::Insulating {}, _) => Some(Electrode::Insulating),
     };
+    let history = raw.tangential_history.as_ref().map(|h| {
+        let limit = raw.friction * raw.normal_load;
+        let scale = match h.unit {
+            LoadUnit::FractionOfLimit => limit,
+            LoadUnit::NewtonPerMetre => 1.0,
+        };
+        let lead: Vec<(f64, f64)> = h.points.iter().map(|(t, q)| (*t, q * scale)).collect();
+        let cycle: Vec<(f64, f64)> = h.cycle.iter().map(|(t, q)| (*t, q * scale)).collect();
+        let points = crate::history::LoadHistory::with_cycles(
+            &lead,
+            &cycle,
+            if cycle.is_empty() { 0 } else { h.repeats },
+        );
+        let history = crate::history::LoadHistory {
+            points,
+            steps_per_segment: h.steps_per_segment,
+            max_step: h.max_step.map_or(0.05 * limit, |m| m * scale),
+        };
+        if raw.friction <= 0.0 {
+            issues.push(Issue::new(
+                "tangential_history",
+                "a history is invalid without friction; it must have `friction` > 0",
+            ));
+        } else if limit.is_finite() && limit > 0.0 {
+            issues.extend(history.validate("tangential_history", limit));
+        }
+        if !h.cycle.is_empty() {
+            for (i, w) in h.cycle.windows(2).enumerate() {
+                if w[1].0 <= w[0].0 {
+                    issues.push(Issue::new(
+                        format!("tangential_history.cycle[{}].t", i + 1),
+                        format!(
+                            "{} s is invalid; it must be > previous Δt = {} s",
+                            w[1].0, w[0].0
+                        ),
+                    ));
+                }
+            }
+            if h.cycle[0].0 <= 0.0 {
+                issues.push(Issue::new(
+                    "tangential_history.cycle[0].t",
+                    format!("{} s is invalid; it must be > 0", h.cycle[0].0),
+                ));
+            }
+        }
+        history
+    });
     match (material, electrode, issues.is_empty()) {
         (Some(material), Some(electrode), true) => {
             let model = ContactModel::new(material, raw.punch.radius, raw.friction, electrode)
@@ -325,6 +426,7 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
                 model,
                 normal_load: raw.normal_load,
                 collocation_points: m,
+                history,
                 raw,
             })
         }
@@ -388,7 +490,15 @@ mod tests {
             .replace("\"friction\": 0.3", "\"friction\": -1")
             .replace("\"normal_load\": 2000.0", "\"normal_load\": 0");
         let paths: Vec<_> = issues(&text).into_iter().map(|i| i.path).collect();
-        assert_eq!(paths, ["punch.radius", "normal_load", "friction"]);
+        assert_eq!(
+            paths,
+            [
+                "punch.radius",
+                "normal_load",
+                "friction",
+                "tangential_history"
+            ]
+        );
         let msg = issues(&text)[0].to_string();
         assert_eq!(
             msg,
@@ -420,5 +530,58 @@ mod tests {
         let text =
             DEFAULT_SCENARIO.replace("\"charge\": 6e-7", "\"charge\": 6e-7, \"potential\": 1.0");
         assert_eq!(issues(&text)[0].path, "punch.electrode");
+    }
+}
+
+#[cfg(test)]
+mod history_tests {
+    use super::*;
+
+    fn issues_of(text: &str) -> Vec<Issue> {
+        validate(parse(text, Path::new("t.json")).unwrap())
+            .err()
+            .unwrap_or_default()
+    }
+
+    #[test]
+    fn history_rules_name_the_point() {
+        let base = DEFAULT_SCENARIO.replace(
+            "[[0.0, 0.0], [1.0, 0.5]]",
+            "[[0.0, 0.0], [1.0, 1.2], [0.5, 0.1]]",
+        );
+        let paths: Vec<_> = issues_of(&base).into_iter().map(|i| i.path).collect();
+        assert_eq!(
+            paths,
+            [
+                "tangential_history.points[1].q",
+                "tangential_history.points[2].t"
+            ]
+        );
+        let newton = DEFAULT_SCENARIO
+            .replace("\"fraction_of_limit\"", "\"newton_per_metre\"")
+            .replace("[[0.0, 0.0], [1.0, 0.5]]", "[[0.0, 0.0], [1.0, 600.0]]");
+        let found = issues_of(&newton);
+        assert_eq!(found[0].path, "tangential_history.points[1].q");
+        assert!(
+            found[0].message.contains("|Q| < ηP = 600"),
+            "{}",
+            found[0].message
+        );
+        let backwards =
+            DEFAULT_SCENARIO.replace("[[2.0, -0.5], [4.0, 0.5]]", "[[2.0, -0.5], [1.0, 0.5]]");
+        assert!(
+            issues_of(&backwards)
+                .iter()
+                .any(|i| i.path == "tangential_history.cycle[1].t")
+        );
+    }
+
+    #[test]
+    fn default_history_has_three_cycles_in_newtons() {
+        let s = default_scenario();
+        let h = s.history.unwrap();
+        assert_eq!(h.points.len(), 8);
+        assert!((h.points[1].1 - 300.0).abs() < 1e-9 && (h.points[2].1 + 300.0).abs() < 1e-9);
+        assert!((h.max_step - 30.0).abs() < 1e-9);
     }
 }

@@ -35,6 +35,7 @@ struct Summary {
     scenario: serde_json::Value,
     derived: serde_json::Value,
     normal_loading: Normal,
+    history: Option<serde_json::Value>,
     warnings: Vec<String>,
 }
 
@@ -99,6 +100,18 @@ fn default_run_reports_the_paper_baseline_and_the_interpenetration_warning() {
     assert!(output.status.success());
     let s = read_summary(&out);
     assert_eq!(s.scenario["name"], "baseline");
+    // Normal loading then three ±½ηP cycles: 10 + 6 × 20 steps, seven phases, no failure.
+    let h = s.history.as_ref().unwrap();
+    assert_eq!(h["steps"], 130);
+    assert_eq!(h["phases"], 7);
+    assert!(h["failure"].is_null());
+    let steps = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    assert!(
+        steps.starts_with(
+            "step,t_s,Q_N_per_m,Q_over_etaP,regime,phase,a_m,e_m,stick_lo_m,stick_hi_m"
+        )
+    );
+    assert_eq!(steps.lines().count(), 132);
     assert!(s.warnings.iter().any(|w| w.contains("Γ1")));
     assert!(s.normal_loading.outside_gap["min_gap"].as_f64().unwrap() < 0.0);
     assert!(s.normal_loading.pressure_charge > 4.9e-7 && s.normal_loading.pressure_charge < 5.1e-7);
