@@ -35,7 +35,7 @@ pub enum Command {
         /// `FIELD=START:END:COUNT` (repeatable; the Cartesian product is run).
         #[arg(long, required = true)]
         vary: Vec<crate::app::Vary>,
-        /// Output folder (default: output/<scenario name>-sweep).
+        /// Output folder (default: `output/<scenario name>-sweep`).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Run only every N-th variant starting at I (`I/N`), for array jobs.
