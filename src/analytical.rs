@@ -179,3 +179,28 @@ impl CattaneoMindlin {
         self.loading_traction(q_star, x) - 2.0 * self.loading_traction((q_star - q) / 2.0, x)
     }
 }
+
+impl CattaneoMindlin {
+    /// Punch displacement after loading from 0 to Q (m), for tangential compliance `y11 = 2/E*`
+    /// and datum distance d (the regularised kernel `−ln(|r|/d)`):
+    /// `δ = −(y11 ηP/π)[ln(a/2d) − ½ − (c/a)²(ln(c/2d) − ½)]`, odd in Q. It follows from
+    /// `ux(0) = −(y11/π)∫ q(s) ln(|s|/d) ds` and `∫√(a² − s²) ln(|s|/d) ds = (πa²/2)(ln(a/2d) − ½)`.
+    pub fn loading_displacement(&self, q: f64, y11: f64, d: f64) -> f64 {
+        let limit = self.friction * self.normal_load;
+        let a = self.half_width;
+        let ratio = 1.0 - q.abs() / limit;
+        let c = a * ratio.max(0.0).sqrt();
+        let inner = if c > 0.0 {
+            ratio * ((c / (2.0 * d)).ln() - 0.5)
+        } else {
+            0.0
+        };
+        -q.signum() * y11 * limit / std::f64::consts::PI * (((a / (2.0 * d)).ln() - 0.5) - inner)
+    }
+
+    /// Displacement on the branch from a reversal at Q* (Masing): `δ(Q*) − 2 δ_load((Q* − Q)/2)`.
+    pub fn unloading_displacement(&self, q_star: f64, q: f64, y11: f64, d: f64) -> f64 {
+        self.loading_displacement(q_star, y11, d)
+            - 2.0 * self.loading_displacement((q_star - q) / 2.0, y11, d)
+    }
+}

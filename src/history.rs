@@ -208,6 +208,11 @@ pub struct StepRecord {
     pub residual: f64,
     /// Checks.
     pub admissibility: StepAdmissibility,
+    /// Tangential displacement δ of the punch relative to the half-plane's datum (m), zero at
+    /// the end of normal loading.
+    pub displacement: f64,
+    /// Energy dissipated by friction in this step (J/m), `−∫ q Δs dx` with the mid-step q.
+    pub dissipation: f64,
 }
 
 /// Receives the accepted steps (progress bars, writers, test recorders).
@@ -264,6 +269,10 @@ pub struct DriverState {
     base: Option<Arc<crate::contact::StickZone>>,
     /// Tangential load at the start of the phase (N/m).
     phase_start_load: f64,
+    /// Accumulated punch displacement δ (m).
+    pub displacement: f64,
+    /// Dissipation of the last step (J/m).
+    last_dissipation: f64,
 }
 
 impl DriverState {
@@ -282,6 +291,8 @@ impl DriverState {
             history: Vec::new(),
             base,
             phase_start_load: 0.0,
+            displacement: 0.0,
+            last_dissipation: 0.0,
         }
     }
 }
@@ -336,6 +347,7 @@ pub fn advance(
     let regime = next_regime(dq, 1e-12 * model.friction * driver.state.normal_load);
     let Some(sign) = regime.slip_sign() else {
         // Hold: nothing changes.
+        driver.last_dissipation = 0.0;
         let mut rec = record(step, t, driver, regime, None);
         rec.q = q;
         observer.on_step(&rec, &driver.state);
@@ -411,6 +423,9 @@ pub fn advance(
         driver.history.clear();
         observer.on_phase(driver.phase, &driver.memory);
     }
+    let (d_delta, dissipation) = step_increments(model, &driver.state, &solved.state);
+    driver.displacement += d_delta;
+    driver.last_dissipation = dissipation;
     driver.state = solved.state.clone();
     let stick = driver
         .state
@@ -458,7 +473,69 @@ fn record(
         newton_iterations: solved.map_or(0, |x| x.newton_iterations),
         residual: solved.map_or(0.0, |x| x.residual),
         admissibility: solved.map_or_else(StepAdmissibility::default, |x| x.admissibility),
+        displacement: driver.displacement,
+        dissipation: driver.last_dissipation,
     }
+}
+
+/// Increment of the punch displacement and the frictional dissipation between two states.
+///
+/// The punch moves rigidly, so on the new stick zone `Δux` is uniform and equals `Δδ`; it is
+/// averaged over three points of the stick zone. In a slip zone the slip increment is
+/// `Δs(x) = ∫ from the stick end to x of Δε` (Δε the change of the surface strain), and the
+/// dissipated energy `−∫ q̄ Δs dx` (q̄ the mean of the two tractions, second order in the step)
+/// is evaluated after an integration by parts as `∓∫ Δε(t) T(t) dt`, with T the integral of q̄
+/// from t to the contact end, so that Δε is needed only at the quadrature nodes.
+pub fn step_increments(model: &ContactModel, old: &ContactState, new: &ContactState) -> (f64, f64) {
+    let Some(stick) = new.traction.stick.as_ref() else {
+        return (0.0, 0.0);
+    };
+    let (mid, half) = (stick.mid(), stick.half());
+    let d_ux = |x: f64| new.surface_displacement(model, x) - old.surface_displacement(model, x);
+    let d_delta = [-0.5, 0.0, 0.5]
+        .iter()
+        .map(|f| d_ux(mid + f * half))
+        .sum::<f64>()
+        / 3.0;
+    let q_mean = |x: f64| 0.5 * (old.traction_at(x) + new.traction_at(x));
+    let d_strain = |x: f64| new.strain_at(model, x) - old.strain_at(model, x);
+    let left_end = (old.centre - old.half_width).min(new.centre - new.half_width);
+    let right_end = (old.centre + old.half_width).max(new.centre + new.half_width);
+    let mut breaks = new.traction_breakpoints();
+    breaks.extend(old.traction_breakpoints());
+    let (nodes, weights) = crate::contact::graded_rule();
+    // ∫ f over [from, to] split at the traction's breakpoints.
+    let integrate = |from: f64, to: f64, f: &dyn Fn(f64) -> f64| -> f64 {
+        let (lo, hi) = (from.min(to), from.max(to));
+        let mut pts: Vec<f64> = breaks
+            .iter()
+            .copied()
+            .filter(|x| *x > lo && *x < hi)
+            .collect();
+        pts.extend([lo, hi]);
+        pts.sort_by(f64::total_cmp);
+        pts.dedup();
+        let sum: f64 = pts
+            .windows(2)
+            .map(|w| {
+                let (m, h) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+                nodes
+                    .iter()
+                    .zip(weights)
+                    .map(|(u, wt)| wt * h * f(m + h * u))
+                    .sum::<f64>()
+            })
+            .sum();
+        if to >= from { sum } else { -sum }
+    };
+    // Right zone: −∫_{hi}^{R} Δε(t) ∫_t^R q̄; left zone: +∫_{L}^{lo} Δε(t) ∫_L^t q̄.
+    let right = integrate(stick.hi, right_end, &|t| {
+        d_strain(t) * integrate(t, right_end, &q_mean)
+    });
+    let left = integrate(left_end, stick.lo, &|t| {
+        d_strain(t) * integrate(left_end, t, &q_mean)
+    });
+    (d_delta, -right + left)
 }
 
 /// A finished run: the records and the final driver state.

@@ -772,3 +772,81 @@ impl ContactModel {
         report
     }
 }
+
+impl ContactState {
+    /// Graded quadrature over the contact split at the stick ends and at `split` (if inside):
+    /// `Σ w f(t)` for `∫ f dt`.
+    fn contact_integral(&self, split: Option<f64>, f: &dyn Fn(f64) -> f64) -> f64 {
+        let (c, a) = (self.centre, self.half_width);
+        let mut pts = vec![c - a, c + a];
+        pts.extend(self.traction_breakpoints());
+        pts.retain(|x| *x >= c - a && *x <= c + a);
+        if let Some(x) = split {
+            if x > c - a && x < c + a {
+                pts.push(x);
+            }
+        }
+        pts.sort_by(f64::total_cmp);
+        pts.dedup();
+        let (nodes, weights) = graded_rule();
+        pts.windows(2)
+            .map(|w| {
+                let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+                nodes
+                    .iter()
+                    .zip(weights)
+                    .map(|(u, wt)| wt * half * f(mid + half * u))
+                    .sum::<f64>()
+            })
+            .sum()
+    }
+
+    /// Surface tangential displacement `ux(x)` with the regularised kernel of seed eq. (4),
+    /// `∫₀^∞ cos(sr)/s ds → −ln(|r|/d)`:
+    /// `ux(x) = −½ ∫ ((w12 + χ w13) p + w13 w)(s) sign(x − s) ds − (y11/π) ∫ q(s) ln(|x − s|/d) ds`.
+    /// The datum d adds `(y11/π) ln(d) Q`, a term linear in Q.
+    pub fn surface_displacement(&self, model: &ContactModel, x: f64) -> f64 {
+        let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
+        let local = model.local_pressure_strain(self.split);
+        let d = model.reference_distance;
+        let integrand = |s: f64| {
+            let tau = (s - self.centre) / self.half_width;
+            let f = local * self.pressure_at(s) + w13 * self.potential_charge.density(tau);
+            let sign = (x - s).signum();
+            let log = if (x - s).abs() > 0.0 {
+                ((x - s).abs() / d).ln()
+            } else {
+                0.0
+            };
+            -0.5 * f * sign
+                - model.compliance.y11 / std::f64::consts::PI * self.traction_at(s) * log
+        };
+        self.contact_integral(Some(x), &integrand)
+    }
+
+    /// Where the traction is not smooth: the stick ends and the ends (and fade ramps) of the
+    /// inherited corrections.
+    pub fn traction_breakpoints(&self) -> Vec<f64> {
+        let mut pts = Vec::new();
+        let mut zone = self
+            .traction
+            .stick
+            .as_ref()
+            .map(|z| (z.lo, z.hi, z.inherited.clone()));
+        while let Some((lo, hi, inherited)) = zone {
+            pts.extend([lo, hi]);
+            zone = inherited.map(|i| {
+                for r in [i.ramp_lo, i.ramp_hi].into_iter().flatten() {
+                    pts.extend([r.0, r.1]);
+                }
+                (i.zone.lo, i.zone.hi, i.zone.inherited.clone())
+            });
+        }
+        pts
+    }
+
+    /// `∫ q f dx` over the contact (pieces split at the stick ends).
+    pub fn traction_moment(&self, f: &dyn Fn(f64) -> f64) -> f64 {
+        self.contact_integral(None, &|s| self.traction_at(s) * f(s))
+    }
+}
