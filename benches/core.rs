@@ -15,7 +15,9 @@ const SIZES: [usize; 5] = [32, 64, 128, 256, 512];
 fn kernels(c: &mut Criterion) {
     let mut g = c.benchmark_group("kernel/assemble_and_factor");
     for m in SIZES {
-        g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, &m| b.iter(|| black_box(Discretisation::new(m))));
+        g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, &m| {
+            b.iter(|| black_box(Discretisation::new(m)))
+        });
     }
     g.finish();
 }
@@ -27,7 +29,12 @@ fn normal(c: &mut Criterion) {
     for m in [32, 64, 128] {
         let disc = Discretisation::new(m);
         g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
-            b.iter(|| black_box(solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap()))
+            b.iter(|| {
+                black_box(
+                    solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default())
+                        .unwrap(),
+                )
+            })
         });
     }
     g.finish();
@@ -40,18 +47,45 @@ fn steps(c: &mut Criterion) {
     forward.sample_size(10);
     for m in [32, 64, 128] {
         let disc = Discretisation::new(m);
-        let normal = solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
+        let normal =
+            solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
         // A state in the middle of the first forward phase, then one more step.
         let mut driver = DriverState::after_normal_loading(&normal);
         for (i, q) in [0.1, 0.2, 0.3].iter().enumerate() {
-            let point = LoadPoint { step: i + 1, t: i as f64, q: q * lim };
-            advance(&sc.model, &disc, &mut driver, point, SlipOptions::default(), &mut NoObserver).unwrap();
+            let point = LoadPoint {
+                step: i + 1,
+                t: i as f64,
+                q: q * lim,
+            };
+            advance(
+                &sc.model,
+                &disc,
+                &mut driver,
+                point,
+                SlipOptions::default(),
+                &mut NoObserver,
+            )
+            .unwrap();
         }
         forward.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
             b.iter(|| {
                 let mut d = driver.clone();
-                let point = LoadPoint { step: 4, t: 4.0, q: 0.35 * lim };
-                black_box(advance(&sc.model, &disc, &mut d, point, SlipOptions::default(), &mut NoObserver).unwrap())
+                let point = LoadPoint {
+                    step: 4,
+                    t: 4.0,
+                    q: 0.35 * lim,
+                };
+                black_box(
+                    advance(
+                        &sc.model,
+                        &disc,
+                        &mut d,
+                        point,
+                        SlipOptions::default(),
+                        &mut NoObserver,
+                    )
+                    .unwrap(),
+                )
             })
         });
     }
@@ -65,17 +99,44 @@ fn reversal(c: &mut Criterion) {
     g.sample_size(10);
     for m in [32, 64] {
         let disc = Discretisation::new(m);
-        let normal = solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
+        let normal =
+            solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
         let mut driver = DriverState::after_normal_loading(&normal);
         for i in 1..=10 {
-            let point = LoadPoint { step: i, t: i as f64, q: 0.05 * i as f64 * lim };
-            advance(&sc.model, &disc, &mut driver, point, SlipOptions::default(), &mut NoObserver).unwrap();
+            let point = LoadPoint {
+                step: i,
+                t: i as f64,
+                q: 0.05 * i as f64 * lim,
+            };
+            advance(
+                &sc.model,
+                &disc,
+                &mut driver,
+                point,
+                SlipOptions::default(),
+                &mut NoObserver,
+            )
+            .unwrap();
         }
         g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
             b.iter(|| {
                 let mut d = driver.clone();
-                let point = LoadPoint { step: 11, t: 11.0, q: 0.45 * lim };
-                black_box(advance(&sc.model, &disc, &mut d, point, SlipOptions::default(), &mut NoObserver).unwrap())
+                let point = LoadPoint {
+                    step: 11,
+                    t: 11.0,
+                    q: 0.45 * lim,
+                };
+                black_box(
+                    advance(
+                        &sc.model,
+                        &disc,
+                        &mut d,
+                        point,
+                        SlipOptions::default(),
+                        &mut NoObserver,
+                    )
+                    .unwrap(),
+                )
             })
         });
     }
@@ -89,14 +150,29 @@ fn cycle(c: &mut Criterion) {
     g.sample_size(10);
     for m in [32, 64] {
         let disc = Discretisation::new(m);
-        let normal = solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
+        let normal =
+            solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
         let history = LoadHistory {
-            points: vec![(0.0, 0.0), (1.0, 0.5 * lim), (3.0, -0.5 * lim), (5.0, 0.5 * lim)],
+            points: vec![
+                (0.0, 0.0),
+                (1.0, 0.5 * lim),
+                (3.0, -0.5 * lim),
+                (5.0, 0.5 * lim),
+            ],
             steps_per_segment: 10,
             max_step: 0.05 * lim,
         };
         g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
-            b.iter(|| black_box(run_history(&sc.model, &disc, &normal, &history, SlipOptions::default(), &mut NoObserver)))
+            b.iter(|| {
+                black_box(run_history(
+                    &sc.model,
+                    &disc,
+                    &normal,
+                    &history,
+                    SlipOptions::default(),
+                    &mut NoObserver,
+                ))
+            })
         });
     }
     g.finish();

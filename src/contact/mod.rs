@@ -781,10 +781,8 @@ impl ContactState {
         let mut pts = vec![c - a, c + a];
         pts.extend(self.traction_breakpoints());
         pts.retain(|x| *x >= c - a && *x <= c + a);
-        if let Some(x) = split {
-            if x > c - a && x < c + a {
-                pts.push(x);
-            }
+        if let Some(x) = split.filter(|x| *x > c - a && *x < c + a) {
+            pts.push(x);
         }
         pts.sort_by(f64::total_cmp);
         pts.dedup();
