@@ -663,3 +663,56 @@ fn reference_fretting_loop_uncoupled() {
     }
     assert_relative_eq!(areas[0], areas[1], max_relative = 1e-9);
 }
+
+/// Cycle analysis on the uncoupled contact: ±½ηP cycles repeat from the first (loop
+/// area = friction work); a block of ±0.3ηP cycles followed by ±0.5ηP is not reported as
+/// settled across the block change.
+#[test]
+fn cycle_verdicts() {
+    use fretsim::app::{Verdict, analyse_cycles};
+    use fretsim::contact::normal::{NormalOptions, solve_normal};
+    use fretsim::contact::tangential::SlipOptions;
+    use fretsim::history::{LoadHistory, NoObserver, run_history};
+    use fretsim::material::IsotropicConstants;
+    let iso = IsotropicConstants {
+        shear_modulus: 27.3e9,
+        poisson_ratio: 0.5,
+    };
+    let (p_load, eta) = (2240.0, 0.3);
+    let lim = eta * p_load;
+    let model = ContactModel::new(Material::Elastic(iso), 10e-3, eta, Electrode::None);
+    let disc = Discretisation::new(32);
+    let normal = solve_normal(&model, &disc, p_load, NormalOptions::default()).unwrap();
+    let run = |amps: &[f64]| {
+        let mut pts = vec![(0.0, 0.0)];
+        for (i, a) in amps.iter().enumerate() {
+            pts.push((pts.len() as f64, if i % 2 == 0 { *a } else { -*a } * lim));
+        }
+        let history = LoadHistory {
+            points: pts,
+            steps_per_segment: 10,
+            max_step: lim,
+        };
+        run_history(
+            &model,
+            &disc,
+            &normal,
+            &history,
+            SlipOptions::default(),
+            &mut NoObserver,
+        )
+        .unwrap()
+        .records
+    };
+    let steady = run(&[0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5]);
+    let (cycles, verdict) = analyse_cycles(&steady, 1e-6);
+    assert_eq!(cycles.len(), 3);
+    // Masing: the +½ state after virgin loading is already the cyclic one.
+    assert_eq!(verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 });
+    for c in &cycles {
+        assert_relative_eq!(c.friction_work, c.loop_area, max_relative = 1e-6);
+    }
+    let growing = run(&[0.3, 0.3, 0.3, 0.3, 0.3, 0.5, 0.5]);
+    let (_, verdict) = analyse_cycles(&growing, 1e-6);
+    assert!(matches!(verdict, Verdict::NotSettled { .. }), "{verdict:?}");
+}
