@@ -311,6 +311,8 @@ fn cycles_csv(cycles: &[CycleRow]) -> Vec<u8> {
                 c.steps.1 as f64,
                 c.loop_area,
                 c.friction_work,
+                c.normal_work,
+                c.electric_work,
                 c.displacement_extremes.0,
                 c.displacement_extremes.1,
                 c.stick_at_max.0,
@@ -328,6 +330,8 @@ fn cycles_csv(cycles: &[CycleRow]) -> Vec<u8> {
             "last_step",
             "loop_area_J_per_m",
             "friction_work_J_per_m",
+            "normal_work_J_per_m",
+            "electric_work_J_per_m",
             "delta_at_max_m",
             "delta_at_min_m",
             "stick_lo_at_max_m",
@@ -611,6 +615,10 @@ pub struct CycleRow {
     pub loop_area: f64,
     /// Frictional work Σ −∫ q Δs (J/m).
     pub friction_work: f64,
+    /// Work of the normal load over the cycle (J/m); zero over a closed cycle.
+    pub normal_work: f64,
+    /// Work of the electric load over the cycle (J/m).
+    pub electric_work: f64,
     /// δ at the positive and at the negative extreme (m).
     pub displacement_extremes: (f64, f64),
     /// Stick-zone ends at the positive extreme (m).
@@ -672,6 +680,8 @@ pub fn analyse_cycles(
             .map(|p| 0.5 * (p[0].q + p[1].q) * (p[1].displacement - p[0].displacement))
             .sum();
         let work = seg[1..].iter().map(|r| r.dissipation).sum();
+        let normal_work = seg[1..].iter().map(|r| r.normal_work).sum();
+        let electric_work = seg[1..].iter().map(|r| r.electric_work).sum();
         let min = seg
             .iter()
             .min_by(|a, b| a.q.total_cmp(&b.q))
@@ -682,6 +692,8 @@ pub fn analyse_cycles(
             steps: (seg[0].step, hi_rec.step),
             loop_area: area,
             friction_work: work,
+            normal_work,
+            electric_work,
             displacement_extremes: (hi_rec.displacement, lo_rec.displacement),
             stick_at_max: (hi_rec.stick_lo, hi_rec.stick_hi),
             stick_at_min: (lo_rec.stick_lo, lo_rec.stick_hi),

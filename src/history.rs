@@ -213,6 +213,10 @@ pub struct StepRecord {
     pub displacement: f64,
     /// Energy dissipated by friction in this step (J/m), `−∫ q Δs dx` with the mid-step q.
     pub dissipation: f64,
+    /// Work of the normal load in this step, `P Δδn` (J/m).
+    pub normal_work: f64,
+    /// Work of the electric load in this step, `φ̄0 ΔΓ` (J/m; zero under charge control).
+    pub electric_work: f64,
 }
 
 /// Receives the accepted steps (progress bars, writers, test recorders).
@@ -273,6 +277,10 @@ pub struct DriverState {
     pub displacement: f64,
     /// Dissipation of the last step (J/m).
     last_dissipation: f64,
+    /// Work of P in the last step (J/m).
+    last_normal_work: f64,
+    /// Electric work in the last step (J/m).
+    last_electric_work: f64,
 }
 
 impl DriverState {
@@ -293,6 +301,8 @@ impl DriverState {
             phase_start_load: 0.0,
             displacement: 0.0,
             last_dissipation: 0.0,
+            last_normal_work: 0.0,
+            last_electric_work: 0.0,
         }
     }
 }
@@ -348,6 +358,8 @@ pub fn advance(
     let Some(sign) = regime.slip_sign() else {
         // Hold: nothing changes.
         driver.last_dissipation = 0.0;
+        driver.last_normal_work = 0.0;
+        driver.last_electric_work = 0.0;
         let mut rec = record(step, t, driver, regime, None);
         rec.q = q;
         observer.on_step(&rec, &driver.state);
@@ -426,6 +438,14 @@ pub fn advance(
     let (d_delta, dissipation) = step_increments(model, &driver.state, &solved.state);
     driver.displacement += d_delta;
     driver.last_dissipation = dissipation;
+    let old = &driver.state;
+    let new = &solved.state;
+    driver.last_normal_work =
+        new.normal_load * (new.normal_approach(model) - old.normal_approach(model));
+    driver.last_electric_work = match (old.potential, new.potential) {
+        (Some(a), Some(b)) => 0.5 * (a + b) * (new.charge - old.charge),
+        _ => 0.0,
+    };
     driver.state = solved.state.clone();
     let stick = driver
         .state
@@ -475,6 +495,8 @@ fn record(
         admissibility: solved.map_or_else(StepAdmissibility::default, |x| x.admissibility),
         displacement: driver.displacement,
         dissipation: driver.last_dissipation,
+        normal_work: driver.last_normal_work,
+        electric_work: driver.last_electric_work,
     }
 }
 

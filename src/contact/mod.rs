@@ -843,6 +843,27 @@ impl ContactState {
         pts
     }
 
+    /// Normal approach of the punch `δn = uz(x) + x²/(2R)` (any x in the contact; evaluated at
+    /// the contact centre), with `uz(x) = ½∫ w12 q(s) sign(x − s) ds − (1/π)∫ (y22 p + y23 g)(s)
+    /// ln(|x − s|/d) ds` (eq. B integrated with the regularised kernel).
+    pub fn normal_approach(&self, model: &ContactModel) -> f64 {
+        let x = self.centre;
+        let y23 = model.compliance.electric.map_or(0.0, |e| e.y23);
+        let d = model.reference_distance;
+        let integrand = |s: f64| {
+            let sign = (x - s).signum();
+            let log = if (x - s).abs() > 0.0 {
+                ((x - s).abs() / d).ln()
+            } else {
+                0.0
+            };
+            0.5 * model.compliance.w12 * self.traction_at(s) * sign
+                - (model.compliance.y22 * self.pressure_at(s) + y23 * self.charge_at(s)) * log
+                    / std::f64::consts::PI
+        };
+        self.contact_integral(Some(x), &integrand) + x * x / (2.0 * model.radius)
+    }
+
     /// `∫ q f dx` over the contact (pieces split at the stick ends).
     pub fn traction_moment(&self, f: &dyn Fn(f64) -> f64) -> f64 {
         self.contact_integral(None, &|s| self.traction_at(s) * f(s))
