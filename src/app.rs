@@ -138,11 +138,6 @@ pub fn run(scenario: &Scenario, out_dir: &Path) -> Result<RunResult, Error> {
     run_with(scenario, out_dir, &mut crate::history::NoObserver)
 }
 
-/// Relative tolerance for "the cycle repeats its predecessor": stick ends to 1e−6 a, δ and
-/// energy to 1e−6 — well above the solver tolerance (1e−13) and the repeatability measured for
-/// the default run (cycles agree to ~1e−12), well below any physical drift worth reporting.
-pub const CYCLE_TOLERANCE: f64 = 1e-6;
-
 /// Summary of the tangential history, in `summary.json`.
 #[derive(Debug, Serialize)]
 pub struct HistorySummary {
@@ -216,7 +211,8 @@ pub fn run_with(
             .map(|w| w[0].clone())
             .chain(records.last().filter(|r| r.phase > 0).cloned())
             .collect();
-        let (cycles, verdict) = analyse_cycles(&records, CYCLE_TOLERANCE);
+        let tolerance = scenario.raw.numerics.cycle_tolerance;
+        let (cycles, verdict) = analyse_cycles(&records, tolerance);
         HistorySummary {
             steps: records.len().saturating_sub(1),
             phases: records.last().map_or(0, |r| r.phase),
@@ -224,7 +220,7 @@ pub fn run_with(
             failure: failure.as_ref().map(|e| e.to_string()),
             cycles,
             verdict,
-            verdict_tolerance: CYCLE_TOLERANCE,
+            verdict_tolerance: tolerance,
         }
     });
     let summary = Summary {
@@ -270,7 +266,7 @@ pub fn run_with(
             )?;
             staging.write(
                 "cycles.csv",
-                &cycles_csv(&analyse_cycles(&records, CYCLE_TOLERANCE).0),
+                &cycles_csv(&analyse_cycles(&records, scenario.raw.numerics.cycle_tolerance).0),
             )?;
         }
         if let Some(e) = &failure {

@@ -153,6 +153,14 @@ pub struct RawNumerics {
     /// Number of collocation nodes M per interval (8 ≤ M ≤ 1024, default 64).
     #[serde(default = "default_m")]
     pub collocation_points: usize,
+    /// Relative tolerance for "a cycle repeats its predecessor" in the shakedown verdict
+    /// (0 < tol < 1, default 1e−6).
+    #[serde(default = "default_cycle_tolerance")]
+    pub cycle_tolerance: f64,
+}
+
+fn default_cycle_tolerance() -> f64 {
+    1e-6
 }
 
 fn default_m() -> usize {
@@ -163,6 +171,7 @@ impl Default for RawNumerics {
     fn default() -> Self {
         Self {
             collocation_points: default_m(),
+            cycle_tolerance: default_cycle_tolerance(),
         }
     }
 }
@@ -317,6 +326,13 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
         ));
     }
     let m = raw.numerics.collocation_points;
+    let tol = raw.numerics.cycle_tolerance;
+    if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
+        issues.push(Issue::new(
+            "numerics.cycle_tolerance",
+            format!("{tol} is invalid; it must lie in (0, 1)"),
+        ));
+    }
     if !(8..=1024).contains(&m) {
         issues.push(Issue::new(
             "numerics.collocation_points",
