@@ -309,73 +309,28 @@ fn find_stick_zone(
 ) -> Result<(f64, f64, BoundedSeries, f64), SolveFailure> {
     let a = state.half_width;
     let f = |b: f64| stick_for(model, disc, state, b);
-    // Bracket: scan outward from the guess on a geometric grid in (0, a).
-    let hi_limit = a * (1.0 - 1e-9);
-    let lo_limit = a * 1e-12;
-    let x0 = guess.clamp(lo_limit, hi_limit);
-    let f0 = f(x0).3;
-    let mut bracket = None;
-    for k in 1..60 {
-        let step = 0.02 * a * 1.3f64.powi(k);
-        for x1 in [x0 + step, x0 - step] {
-            let x1 = x1.clamp(lo_limit, hi_limit);
-            let f1 = f(x1).3;
-            if f1.signum() != f0.signum() {
-                bracket = Some(if x1 > x0 {
-                    (x0, f0, x1, f1)
-                } else {
-                    (x1, f1, x0, f0)
-                });
-                break;
-            }
+    // A stick zone below 1e−12 a is full slip for every purpose; just below a, full stick.
+    let (lo_limit, hi_limit) = (a * 1e-12, a * (1.0 - 1e-9));
+    let mut end_condition = |b: f64| f(b).3;
+    match super::roots::bracketed_root(
+        &mut end_condition,
+        guess,
+        lo_limit,
+        hi_limit,
+        0.02 * a,
+        1e-14 * a,
+    ) {
+        Some(b) => {
+            let (slope, series, kink, _) = f(b);
+            Ok((b, slope, series, kink))
         }
-        if bracket.is_some() {
-            break;
-        }
-        if x0 + step >= hi_limit && x0 - step <= lo_limit {
-            break;
+        None => {
+            // No root in (0, a): the candidate is full stick, b = a, whose traction may keep a
+            // √ term at the contact ends (admissible when |q| ≤ ηp there); the caller checks it.
+            let (slope, series, kink, _) = f(a);
+            Ok((a, slope, series, kink))
         }
     }
-    if bracket.is_none() {
-        // The lower end of the range: a stick zone below 1e−12 a is full slip for every purpose.
-        let f_lo = f(lo_limit).3;
-        if f_lo.signum() != f0.signum() {
-            bracket = Some((lo_limit, f_lo, x0, f0));
-        }
-    }
-    let Some((mut xl, mut fl, mut xr, mut fr)) = bracket else {
-        // No root in (0, a): the candidate is full stick, b = a, whose traction may keep a √
-        // term at the contact ends (admissible when |q| ≤ ηp there); the caller checks it.
-        let (slope, series, kink, _) = f(a);
-        return Ok((a, slope, series, kink));
-    };
-    // Illinois (regula falsi) iteration.
-    let mut side = 0;
-    for _ in 0..200 {
-        let xm = (xl * fr - xr * fl) / (fr - fl);
-        let fm = f(xm).3;
-        if fm.signum() == fl.signum() {
-            xl = xm;
-            fl = fm;
-            if side == -1 {
-                fr *= 0.5;
-            }
-            side = -1;
-        } else {
-            xr = xm;
-            fr = fm;
-            if side == 1 {
-                fl *= 0.5;
-            }
-            side = 1;
-        }
-        if (xr - xl) < 1e-14 * a {
-            break;
-        }
-    }
-    let b = 0.5 * (xl + xr);
-    let (slope, series, kink, _) = f(b);
-    Ok((b, slope, series, kink))
 }
 
 /// Worst violations of the admissibility conditions, relative to their scales.
