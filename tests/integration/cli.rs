@@ -236,3 +236,29 @@ fn sweep_writes_one_row_per_variant_and_shards_split_them() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("friction"));
 }
+
+#[test]
+fn unwritable_output_path_exits_2_and_names_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("plain-file");
+    std::fs::write(&file, "x").unwrap();
+    let quick = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/figure5_frictionless.json");
+    let o = fretsim()
+        .arg("run")
+        .arg(&quick)
+        .arg("--out")
+        .arg(file.join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot write"));
+    let bad_m = tmp.path().join("m.json");
+    let text = std::fs::read_to_string(&quick).unwrap().replace(
+        "\"normal_load\": 2000.0",
+        "\"normal_load\": 2000.0, \"numerics\": {\"collocation_points\": 0}",
+    );
+    std::fs::write(&bad_m, text).unwrap();
+    let o = fretsim().arg("check").arg(&bad_m).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("numerics.collocation_points"));
+}
