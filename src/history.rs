@@ -525,7 +525,6 @@ pub fn step_increments(model: &ContactModel, old: &ContactState, new: &ContactSt
     let right_end = (old.centre + old.half_width).max(new.centre + new.half_width);
     let mut breaks = new.traction_breakpoints();
     breaks.extend(old.traction_breakpoints());
-    let (nodes, weights) = crate::contact::graded_rule();
     // ∫ f over [from, to] split at the traction's breakpoints.
     let integrate = |from: f64, to: f64, f: &dyn Fn(f64) -> f64| -> f64 {
         let (lo, hi) = (from.min(to), from.max(to));
@@ -535,19 +534,7 @@ pub fn step_increments(model: &ContactModel, old: &ContactState, new: &ContactSt
             .filter(|x| *x > lo && *x < hi)
             .collect();
         pts.extend([lo, hi]);
-        pts.sort_by(f64::total_cmp);
-        pts.dedup();
-        let sum: f64 = pts
-            .windows(2)
-            .map(|w| {
-                let (m, h) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-                nodes
-                    .iter()
-                    .zip(weights)
-                    .map(|(u, wt)| wt * h * f(m + h * u))
-                    .sum::<f64>()
-            })
-            .sum();
+        let sum = crate::contact::graded_integral(pts, f);
         if to >= from { sum } else { -sum }
     };
     // Right zone: −∫_{hi}^{R} Δε(t) ∫_t^R q̄; left zone: +∫_{L}^{lo} Δε(t) ∫_L^t q̄.

@@ -658,6 +658,26 @@ impl ContactState {
     }
 }
 
+/// `∫ f` from the smallest to the largest of `points`, split at every point, each piece by the
+/// sine-graded Gauss–Legendre rule of [`graded_rule`] (which absorbs square-root and
+/// logarithmic behaviour at the piece ends).
+pub fn graded_integral(mut points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> f64 {
+    points.sort_by(f64::total_cmp);
+    points.dedup();
+    let (nodes, weights) = graded_rule();
+    points
+        .windows(2)
+        .map(|w| {
+            let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+            nodes
+                .iter()
+                .zip(weights)
+                .map(|(u, wt)| wt * half * f(mid + half * u))
+                .sum::<f64>()
+        })
+        .sum()
+}
+
 /// Sine-graded Gauss–Legendre rule on [−1, 1]: `u = sin(πv/2)`, nodes clustered like
 /// Chebyshev points at both ends (resolves √ end behaviour and near-singular quotients).
 pub fn graded_rule() -> &'static (Vec<f64>, Vec<f64>) {
@@ -774,29 +794,20 @@ impl ContactModel {
 }
 
 impl ContactState {
-    /// Graded quadrature over the contact split at the stick ends and at `split` (if inside):
-    /// `Σ w f(t)` for `∫ f dt`.
-    fn contact_integral(&self, split: Option<f64>, f: &dyn Fn(f64) -> f64) -> f64 {
+    /// Graded quadrature over the contact split at the traction's breakpoints and at `split`
+    /// (if inside): `∫ f dt`.
+    pub fn contact_integral(&self, split: Option<f64>, f: &dyn Fn(f64) -> f64) -> f64 {
         let (c, a) = (self.centre, self.half_width);
         let mut pts = vec![c - a, c + a];
-        pts.extend(self.traction_breakpoints());
-        pts.retain(|x| *x >= c - a && *x <= c + a);
+        pts.extend(
+            self.traction_breakpoints()
+                .into_iter()
+                .filter(|x| *x >= c - a && *x <= c + a),
+        );
         if let Some(x) = split.filter(|x| *x > c - a && *x < c + a) {
             pts.push(x);
         }
-        pts.sort_by(f64::total_cmp);
-        pts.dedup();
-        let (nodes, weights) = graded_rule();
-        pts.windows(2)
-            .map(|w| {
-                let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-                nodes
-                    .iter()
-                    .zip(weights)
-                    .map(|(u, wt)| wt * half * f(mid + half * u))
-                    .sum::<f64>()
-            })
-            .sum()
+        graded_integral(pts, f)
     }
 
     /// Surface tangential displacement `ux(x)` with the regularised kernel of seed eq. (4),

@@ -43,7 +43,7 @@ use crate::quadrature::{BoundedSeries, UnboundedSeries};
 use super::pressure::{
     Discretisation, electric_resultants, solve_potential_charge, solve_pressure,
 };
-use super::{ContactModel, ContactState, StickZone, Traction, graded_rule};
+use super::{ContactModel, ContactState, StickZone, Traction};
 
 /// Result of the normal-loading solve.
 #[derive(Debug, Clone, Serialize)]
@@ -87,21 +87,13 @@ impl Default for NormalOptions {
 
 /// `J_q = ∫ q(s) arcsin((s − c)/a) ds` over the contact (for the contact potential).
 pub fn arcsine_moment(state: &ContactState) -> f64 {
-    let Some(stick) = &state.traction.stick else {
+    if state.traction.stick.is_none() {
         return 0.0;
-    };
-    let (c, a) = (state.centre, state.half_width);
-    let ends = [c - a, stick.lo.max(c - a), stick.hi.min(c + a), c + a];
-    let (nodes, weights) = graded_rule();
-    let mut sum = 0.0;
-    for seg in ends.windows(2) {
-        let (mid, half) = (0.5 * (seg[0] + seg[1]), 0.5 * (seg[1] - seg[0]));
-        for (u, w) in nodes.iter().zip(weights) {
-            let s = mid + half * u;
-            sum += w * half * state.traction_at(s) * ((s - c) / a).clamp(-1.0, 1.0).asin();
-        }
     }
-    sum
+    let (c, a) = (state.centre, state.half_width);
+    state.contact_integral(None, &|s| {
+        state.traction_at(s) * ((s - c) / a).clamp(-1.0, 1.0).asin()
+    })
 }
 
 /// Solve the stick sub-problem for a trial b: returns (C, q̃ smooth part, kink amplitude, ψ̃(1)).

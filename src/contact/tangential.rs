@@ -304,20 +304,7 @@ impl StepProblem<'_> {
         let stick = state.traction.stick.as_ref().expect("set above");
         let shape_force = if (self.signs.0 - self.signs.1).abs() > 0.0 {
             // ∫ p S dx over the contact, piecewise by the graded rule.
-            let (nodes, weights) = graded_rule();
-            let ends = [g.c - g.a, g.lo, g.hi, g.c + g.a];
-            ends.windows(2)
-                .map(|e| {
-                    let (m2, h2) = (0.5 * (e[0] + e[1]), 0.5 * (e[1] - e[0]));
-                    nodes
-                        .iter()
-                        .zip(weights)
-                        .map(|(u, w)| {
-                            w * h2 * state.pressure_at(m2 + h2 * u) * state.slip_shape(m2 + h2 * u)
-                        })
-                        .sum::<f64>()
-                })
-                .sum()
+            state.contact_integral(None, &|x| state.pressure_at(x) * state.slip_shape(x))
         } else {
             self.signs.1 * pressure_force
         };
