@@ -269,6 +269,13 @@ pub fn run_with(
                 &cycles_csv(&analyse_cycles(&records, scenario.raw.numerics.cycle_tolerance).0),
             )?;
         }
+        for (name, svg) in plots(&points, &records, model.friction * scenario.normal_load) {
+            staging.write(&format!("plots/{name}.svg"), svg.as_bytes())?;
+        }
+        staging.write(
+            "index.html",
+            index_html(&scenario.name, &records).as_bytes(),
+        )?;
         if let Some(e) = &failure {
             let body = serde_json::json!({
                 "error": e.to_string(),
@@ -294,6 +301,155 @@ pub fn run_with(
             Err(e)
         }
     }
+}
+
+/// The SVG plots of a run: fields at the end of normal loading, and with a history the
+/// hysteresis loop and the stick-zone ends.
+fn plots(
+    points: &[SurfacePoint],
+    records: &[crate::history::StepRecord],
+    limit: f64,
+) -> Vec<(&'static str, String)> {
+    use crate::plot::{Series, line_plot};
+    let field =
+        |f: &dyn Fn(&SurfacePoint) -> f64| points.iter().map(|p| (p.x, f(p))).collect::<Vec<_>>();
+    let mut out = vec![
+        (
+            "normal_loading_tractions",
+            line_plot(
+                "End of normal loading: pressure and shear traction",
+                "x (m)",
+                "Pa",
+                &[
+                    Series {
+                        label: "p",
+                        points: field(&|p| p.pressure),
+                        colour: "black",
+                    },
+                    Series {
+                        label: "q (on the half-plane)",
+                        points: field(&|p| p.traction),
+                        colour: "crimson",
+                    },
+                ],
+            ),
+        ),
+        (
+            "normal_loading_charge",
+            line_plot(
+                "End of normal loading: surface charge g",
+                "x (m)",
+                "C/m²",
+                &[Series {
+                    label: "g",
+                    points: field(&|p| p.charge),
+                    colour: "navy",
+                }],
+            ),
+        ),
+        (
+            "normal_loading_sigma_xx",
+            line_plot(
+                "End of normal loading: surface stress σxx0",
+                "x (m)",
+                "Pa",
+                &[Series {
+                    label: "σxx0",
+                    points: field(&|p| p.sigma_xx),
+                    colour: "darkgreen",
+                }],
+            ),
+        ),
+        (
+            "normal_loading_d_x",
+            line_plot(
+                "End of normal loading: in-plane electric displacement Dx0",
+                "x (m)",
+                "C/m²",
+                &[Series {
+                    label: "Dx0",
+                    points: field(&|p| p.d_x),
+                    colour: "purple",
+                }],
+            ),
+        ),
+    ];
+    if records.len() > 1 {
+        let loop_pts: Vec<(f64, f64)> = records
+            .iter()
+            .map(|r| (r.displacement, r.q / limit))
+            .collect();
+        out.push((
+            "hysteresis",
+            line_plot(
+                "Fretting loop",
+                "tangential displacement δ (m)",
+                "Q/(ηP)",
+                &[Series {
+                    label: "Q–δ",
+                    points: loop_pts,
+                    colour: "black",
+                }],
+            ),
+        ));
+        let ends = |f: &dyn Fn(&crate::history::StepRecord) -> f64| {
+            records
+                .iter()
+                .map(|r| (r.step as f64, f(r) / r.half_width))
+                .collect::<Vec<_>>()
+        };
+        out.push((
+            "stick_zone",
+            line_plot(
+                "Stick-zone ends and contact ends",
+                "step",
+                "x / a",
+                &[
+                    Series {
+                        label: "stick left end",
+                        points: ends(&|r| r.stick_lo),
+                        colour: "navy",
+                    },
+                    Series {
+                        label: "stick right end",
+                        points: ends(&|r| r.stick_hi),
+                        colour: "crimson",
+                    },
+                    Series {
+                        label: "contact ends",
+                        points: ends(&|r| -r.eccentricity - r.half_width),
+                        colour: "gray",
+                    },
+                    Series {
+                        label: "",
+                        points: ends(&|r| -r.eccentricity + r.half_width),
+                        colour: "gray",
+                    },
+                ],
+            ),
+        ));
+    }
+    out
+}
+
+/// `index.html`: all plots on one page.
+fn index_html(name: &str, records: &[crate::history::StepRecord]) -> String {
+    let mut names = vec![
+        "normal_loading_tractions",
+        "normal_loading_charge",
+        "normal_loading_sigma_xx",
+        "normal_loading_d_x",
+    ];
+    if records.len() > 1 {
+        names.extend(["hysteresis", "stick_zone"]);
+    }
+    let imgs: String = names
+        .iter()
+        .map(|n| format!("<figure><img src=\"plots/{n}.svg\" alt=\"{n}\"></figure>\n"))
+        .collect();
+    format!(
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>fretsim: {name}</title></head>\n<body>\n<h1>fretsim: {name}</h1>\n<p>Files: summary.json, fields/normal_loading.csv, steps.csv, cycles.csv (see README).</p>\n{imgs}</body></html>\n"
+    )
 }
 
 /// `cycles.csv`: one row per fretting cycle.

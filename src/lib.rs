@@ -58,5 +58,6 @@ pub mod halfplane;
 pub mod history;
 pub mod material;
 pub mod output;
+pub mod plot;
 pub mod quadrature;
 pub mod scenario;

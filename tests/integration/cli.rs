@@ -111,6 +111,23 @@ fn default_run_reports_the_paper_baseline_and_the_interpenetration_warning() {
     assert_eq!(h["verdict"]["from_cycle"], 2);
     let cycles = std::fs::read_to_string(out.join("cycles.csv")).unwrap();
     assert_eq!(cycles.lines().count(), 4);
+    for plot in [
+        "hysteresis",
+        "stick_zone",
+        "normal_loading_tractions",
+        "normal_loading_charge",
+    ] {
+        let svg = std::fs::read_to_string(out.join(format!("plots/{plot}.svg"))).unwrap();
+        assert!(
+            svg.starts_with("<svg") && svg.contains("<polyline"),
+            "{plot}"
+        );
+    }
+    assert!(
+        std::fs::read_to_string(out.join("index.html"))
+            .unwrap()
+            .contains("plots/hysteresis.svg")
+    );
     // Energy balance over the steady cycle 3: the loop area equals the frictional work within
     // the time-discretisation error (measured 8.0e−4 with 20 steps per half-cycle), and P does no
     // net work (measured ~1e−19 J/m against 1.6e−7 J/m).
