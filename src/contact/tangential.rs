@@ -436,9 +436,6 @@ fn solve_geometry(
     let mut evaluations = 1;
     for iter in 0..options.max_iterations {
         let size = norm(&r);
-        if std::env::var("FRETSIM_TRACE").is_ok() {
-            eprintln!("newton {iter}: {:?} r {:?}", g, r);
-        }
         if size < options.tolerance {
             if state.split.conducting
                 && !matches!(
@@ -499,9 +496,6 @@ fn solve_geometry(
             }
         }
         let Some(dx) = solve4(jac, r) else { break };
-        if std::env::var("FRETSIM_TRACE").is_ok() {
-            eprintln!("  J {:?} dx {:?}", jac, dx);
-        }
         let mut alpha = 1.0;
         let mut accepted = false;
         for _ in 0..30 {
