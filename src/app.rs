@@ -184,6 +184,11 @@ pub fn run_with(
     // The tangential history, if any; a failure keeps the steps already solved.
     let mut records = Vec::new();
     let mut failure = None;
+    let mut snapshots = Snapshots {
+        inner: observer,
+        previous: None,
+        kept: Vec::new(),
+    };
     if let Some(history) = &scenario.history {
         match crate::history::run_history(
             model,
@@ -191,7 +196,7 @@ pub fn run_with(
             &normal,
             history,
             SlipOptions::default(),
-            observer,
+            &mut snapshots,
         ) {
             Ok(run) => records = run.records,
             Err(f) => {
@@ -269,6 +274,33 @@ pub fn run_with(
                 &cycles_csv(&analyse_cycles(&records, scenario.raw.numerics.cycle_tolerance).0),
             )?;
         }
+        // Fields at the turning points of the history and at its last step.
+        let mut turning: Vec<&(crate::history::StepRecord, crate::contact::ContactState)> =
+            snapshots.kept.iter().collect();
+        if let Some(last) = &snapshots.previous {
+            turning.push(last);
+        }
+        for (rec, state) in turning {
+            let rows: Vec<Vec<f64>> = field_points(state.centre, state.half_width, 400)
+                .into_iter()
+                .map(|x| model.surface_point(state, x))
+                .map(|p| vec![p.x, p.pressure, p.traction, p.charge, p.sigma_xx, p.d_x])
+                .collect();
+            staging.write(
+                &format!("fields/step_{:05}.csv", rec.step),
+                &csv_bytes(
+                    &[
+                        "x_m",
+                        "p_Pa",
+                        "q_Pa",
+                        "g_C_per_m2",
+                        "sigma_xx_Pa",
+                        "d_x_C_per_m2",
+                    ],
+                    &rows,
+                ),
+            )?;
+        }
         for (name, svg) in plots(&points, &records, model.friction * scenario.normal_load) {
             staging.write(&format!("plots/{name}.svg"), svg.as_bytes())?;
         }
@@ -300,6 +332,35 @@ pub fn run_with(
             staging.abandon();
             Err(e)
         }
+    }
+}
+
+/// Forwards steps to the caller's observer and keeps the states at the turning points (the
+/// last step of each phase) for the field files.
+struct Snapshots<'a> {
+    inner: &'a mut dyn crate::history::Observer,
+    previous: Option<(crate::history::StepRecord, crate::contact::ContactState)>,
+    kept: Vec<(crate::history::StepRecord, crate::contact::ContactState)>,
+}
+
+impl crate::history::Observer for Snapshots<'_> {
+    fn on_step(
+        &mut self,
+        record: &crate::history::StepRecord,
+        state: &crate::contact::ContactState,
+    ) {
+        if let Some((prev, prev_state)) = self.previous.take()
+            && prev.phase != record.phase
+            && prev.phase > 0
+        {
+            self.kept.push((prev, prev_state));
+        }
+        self.previous = Some((record.clone(), state.clone()));
+        self.inner.on_step(record, state);
+    }
+
+    fn on_phase(&mut self, phase: usize, memory: &crate::contact::memory::Memory) {
+        self.inner.on_phase(phase, memory);
     }
 }
 
