@@ -7,8 +7,10 @@ use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use fretsim::contact::normal::{NormalOptions, solve_normal};
 use fretsim::contact::pressure::Discretisation;
 use fretsim::contact::tangential::SlipOptions;
-use fretsim::history::{DriverState, LoadHistory, LoadPoint, NoObserver, advance, run_history};
-use fretsim::scenario::default_scenario;
+use fretsim::history::{
+    DriverState, LoadHistory, LoadPoint, NoObserver, StepRecord, advance, run_history,
+};
+use fretsim::scenario::{Scenario, default_scenario};
 
 const SIZES: [usize; 5] = [32, 64, 128, 256, 512];
 
@@ -40,107 +42,70 @@ fn normal(c: &mut Criterion) {
     g.finish();
 }
 
-fn steps(c: &mut Criterion) {
-    let sc = default_scenario();
-    let lim = sc.model.friction * sc.normal_load;
-    let mut forward = c.benchmark_group("solve/forward_step");
-    forward.sample_size(10);
-    for m in [32, 64, 128] {
-        let disc = Discretisation::new(m);
-        let normal =
-            solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
-        // A state in the middle of the first forward phase, then one more step.
-        let mut driver = DriverState::after_normal_loading(&normal);
-        for (i, q) in [0.1, 0.2, 0.3].iter().enumerate() {
-            let point = LoadPoint {
-                step: i + 1,
-                t: i as f64,
-                q: q * lim,
-            };
-            advance(
-                &sc.model,
-                &disc,
-                &mut driver,
-                point,
-                SlipOptions::default(),
-                &mut NoObserver,
-            )
-            .unwrap();
-        }
-        forward.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
-            b.iter(|| {
-                let mut d = driver.clone();
-                let point = LoadPoint {
-                    step: 4,
-                    t: 4.0,
-                    q: 0.35 * lim,
-                };
-                black_box(
-                    advance(
-                        &sc.model,
-                        &disc,
-                        &mut d,
-                        point,
-                        SlipOptions::default(),
-                        &mut NoObserver,
-                    )
-                    .unwrap(),
-                )
-            })
-        });
+/// The driver after normal loading and the given load steps (fractions of ηP).
+fn driver_after(sc: &Scenario, disc: &Discretisation, loads: &[f64]) -> DriverState {
+    let normal = solve_normal(&sc.model, disc, sc.normal_load, NormalOptions::default()).unwrap();
+    let mut driver = DriverState::after_normal_loading(&normal);
+    for (i, f) in loads.iter().enumerate() {
+        step(sc, disc, &mut driver, i + 1, *f);
     }
-    forward.finish();
+    driver
 }
 
-fn reversal(c: &mut Criterion) {
+/// One load step to `f` ηP.
+fn step(
+    sc: &Scenario,
+    disc: &Discretisation,
+    driver: &mut DriverState,
+    n: usize,
+    f: f64,
+) -> StepRecord {
+    let point = LoadPoint {
+        step: n,
+        t: n as f64,
+        q: f * sc.model.friction * sc.normal_load,
+    };
+    advance(
+        &sc.model,
+        disc,
+        driver,
+        point,
+        SlipOptions::default(),
+        &mut NoObserver,
+    )
+    .unwrap()
+}
+
+/// Time one step to `next` ηP from the state after `loads`.
+fn bench_step(c: &mut Criterion, name: &str, sizes: &[usize], loads: &[f64], next: f64) {
     let sc = default_scenario();
-    let lim = sc.model.friction * sc.normal_load;
-    let mut g = c.benchmark_group("solve/reversal_step");
+    let mut g = c.benchmark_group(name);
     g.sample_size(10);
-    for m in [32, 64] {
+    for &m in sizes {
         let disc = Discretisation::new(m);
-        let normal =
-            solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
-        let mut driver = DriverState::after_normal_loading(&normal);
-        for i in 1..=10 {
-            let point = LoadPoint {
-                step: i,
-                t: i as f64,
-                q: 0.05 * i as f64 * lim,
-            };
-            advance(
-                &sc.model,
-                &disc,
-                &mut driver,
-                point,
-                SlipOptions::default(),
-                &mut NoObserver,
-            )
-            .unwrap();
-        }
+        let driver = driver_after(&sc, &disc, loads);
         g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
-            b.iter(|| {
-                let mut d = driver.clone();
-                let point = LoadPoint {
-                    step: 11,
-                    t: 11.0,
-                    q: 0.45 * lim,
-                };
-                black_box(
-                    advance(
-                        &sc.model,
-                        &disc,
-                        &mut d,
-                        point,
-                        SlipOptions::default(),
-                        &mut NoObserver,
-                    )
-                    .unwrap(),
-                )
-            })
+            b.iter(|| black_box(step(&sc, &disc, &mut driver.clone(), loads.len() + 1, next)))
         });
     }
     g.finish();
+}
+
+fn steps(c: &mut Criterion) {
+    // In the middle of the first forward phase.
+    bench_step(
+        c,
+        "solve/forward_step",
+        &[32, 64, 128],
+        &[0.1, 0.2, 0.3],
+        0.35,
+    );
+}
+
+fn reversal(c: &mut Criterion) {
+    // The first step after the turning point at +½ηP.
+    let loads: Vec<f64> = (1..=10).map(|i| 0.05 * i as f64).collect();
+    bench_step(c, "solve/reversal_step", &[32, 64], &loads, 0.45);
 }
 
 fn cycle(c: &mut Criterion) {

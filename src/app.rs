@@ -240,30 +240,13 @@ pub fn run_with(
         .into_iter()
         .map(|x| model.surface_point(&normal.state, x))
         .collect();
-    let rows: Vec<Vec<f64>> = points
-        .iter()
-        .map(|p| vec![p.x, p.pressure, p.traction, p.charge, p.sigma_xx, p.d_x])
-        .collect();
     let staging = Staging::new(out_dir)?;
     let result = (|| {
         staging.write(
             "summary.json",
             &serde_json::to_vec_pretty(&summary).expect("summary serialises"),
         )?;
-        staging.write(
-            "fields/normal_loading.csv",
-            &csv_bytes(
-                &[
-                    "x_m",
-                    "p_Pa",
-                    "q_Pa",
-                    "g_C_per_m2",
-                    "sigma_xx_Pa",
-                    "d_x_C_per_m2",
-                ],
-                &rows,
-            ),
-        )?;
+        staging.write("fields/normal_loading.csv", &fields_csv(&points))?;
         if scenario.history.is_some() {
             staging.write(
                 "steps.csv",
@@ -281,24 +264,13 @@ pub fn run_with(
             turning.push(last);
         }
         for (rec, state) in turning {
-            let rows: Vec<Vec<f64>> = field_points(state.centre, state.half_width, 400)
+            let points: Vec<SurfacePoint> = field_points(state.centre, state.half_width, 400)
                 .into_iter()
                 .map(|x| model.surface_point(state, x))
-                .map(|p| vec![p.x, p.pressure, p.traction, p.charge, p.sigma_xx, p.d_x])
                 .collect();
             staging.write(
                 &format!("fields/step_{:05}.csv", rec.step),
-                &csv_bytes(
-                    &[
-                        "x_m",
-                        "p_Pa",
-                        "q_Pa",
-                        "g_C_per_m2",
-                        "sigma_xx_Pa",
-                        "d_x_C_per_m2",
-                    ],
-                    &rows,
-                ),
+                &fields_csv(&points),
             )?;
         }
         for (name, svg) in plots(&points, &records, model.friction * scenario.normal_load) {
@@ -510,6 +482,25 @@ fn index_html(name: &str, records: &[crate::history::StepRecord]) -> String {
         .collect();
     format!(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>fretsim: {name}</title></head>\n<body>\n<h1>fretsim: {name}</h1>\n<p>Files: summary.json, fields/normal_loading.csv, steps.csv, cycles.csv (see README).</p>\n{imgs}</body></html>\n"
+    )
+}
+
+/// A fields CSV: `x_m, p_Pa, q_Pa, g_C_per_m2, sigma_xx_Pa, d_x_C_per_m2`.
+fn fields_csv(points: &[SurfacePoint]) -> Vec<u8> {
+    let rows: Vec<Vec<f64>> = points
+        .iter()
+        .map(|p| vec![p.x, p.pressure, p.traction, p.charge, p.sigma_xx, p.d_x])
+        .collect();
+    csv_bytes(
+        &[
+            "x_m",
+            "p_Pa",
+            "q_Pa",
+            "g_C_per_m2",
+            "sigma_xx_Pa",
+            "d_x_C_per_m2",
+        ],
+        &rows,
     )
 }
 

@@ -573,40 +573,44 @@ impl ContactState {
         let t = &self.traction;
         let Some(stick) = &t.stick else { return 0.0 };
         let sx = self.slip_shape(x);
-        let mut value = sx * self.pressure_cauchy(x);
-        if let Some(table) = &self.shape_table {
-            let sum: f64 = table
-                .iter()
-                .filter(|(tt, _, _)| (tt - x).abs() > 1e-14 * self.half_width)
-                .map(|(tt, wp, st)| wp * (st - sx) / (tt - x))
-                .sum();
-            return value + sum / std::f64::consts::PI;
+        let value = sx * self.pressure_cauchy(x);
+        if (t.left_sign - t.right_sign).abs() <= 0.0 && self.shape_table.is_none() {
+            return value;
         }
-        if (t.left_sign - t.right_sign).abs() > 0.0 {
-            let ends = [
-                self.centre - self.half_width,
-                stick.lo,
-                stick.hi,
-                self.centre + self.half_width,
-            ];
-            let (nodes, weights) = graded_rule();
-            let mut sum = 0.0;
-            for seg in ends.windows(2) {
-                let (lo, hi) = (seg[0], seg[1]);
-                let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
-                for (u, w) in nodes.iter().zip(weights) {
-                    let tt = mid + half * u;
-                    let quotient = if (tt - x).abs() > 1e-14 * self.half_width {
-                        (self.slip_shape(tt) - sx) / (tt - x)
-                    } else {
-                        0.0
-                    };
-                    sum += w * half * self.pressure_at(tt) * quotient;
-                }
+        let built;
+        let table = match &self.shape_table {
+            Some(table) => table.as_slice(),
+            None => {
+                built = self.shape_nodes(stick);
+                built.as_slice()
             }
-            value += sum / std::f64::consts::PI;
+        };
+        let sum: f64 = table
+            .iter()
+            .filter(|(tt, _, _)| (tt - x).abs() > 1e-14 * self.half_width)
+            .map(|(tt, wp, st)| wp * (st - sx) / (tt - x))
+            .sum();
+        value + sum / std::f64::consts::PI
+    }
+
+    /// Quadrature nodes `(t, w p(t), S(t))` over the left slip, stick and right slip pieces.
+    fn shape_nodes(&self, stick: &StickZone) -> Vec<(f64, f64, f64)> {
+        let ends = [
+            self.centre - self.half_width,
+            stick.lo,
+            stick.hi,
+            self.centre + self.half_width,
+        ];
+        let (nodes, weights) = graded_rule();
+        let mut table = Vec::with_capacity(3 * nodes.len());
+        for seg in ends.windows(2) {
+            let (mid, half) = (0.5 * (seg[0] + seg[1]), 0.5 * (seg[1] - seg[0]));
+            for (u, w) in nodes.iter().zip(weights) {
+                let tt = mid + half * u;
+                table.push((tt, w * half * self.pressure_at(tt), self.slip_shape(tt)));
+            }
         }
-        value
+        table
     }
 
     /// This state with the quadrature of [`Self::shape_cauchy`] tabulated, for states that
@@ -622,22 +626,7 @@ impl ContactState {
         self.shape_table = None;
         let t = &self.traction;
         if let (Some(stick), true) = (&t.stick, (t.left_sign - t.right_sign).abs() > 0.0) {
-            let ends = [
-                self.centre - self.half_width,
-                stick.lo,
-                stick.hi,
-                self.centre + self.half_width,
-            ];
-            let (nodes, weights) = graded_rule();
-            let mut table = Vec::with_capacity(3 * nodes.len());
-            for seg in ends.windows(2) {
-                let (mid, half) = (0.5 * (seg[0] + seg[1]), 0.5 * (seg[1] - seg[0]));
-                for (u, w) in nodes.iter().zip(weights) {
-                    let tt = mid + half * u;
-                    table.push((tt, w * half * self.pressure_at(tt), self.slip_shape(tt)));
-                }
-            }
-            self.shape_table = Some(std::sync::Arc::new(table));
+            self.shape_table = Some(std::sync::Arc::new(self.shape_nodes(stick)));
         }
     }
 
@@ -676,6 +665,22 @@ pub fn graded_integral(mut points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> f64 {
                 .sum::<f64>()
         })
         .sum()
+}
+
+/// One admissibility check: `(name, measure, allowed, reported value, x)`; it fails when
+/// `measure > allowed`.
+pub(crate) type Check<'a> = (&'a str, f64, f64, f64, f64);
+
+/// The first failed check as an [`SolveFailure::Inadmissible`] error.
+pub(crate) fn first_violation(checks: &[Check<'_>]) -> Result<(), crate::error::SolveFailure> {
+    match checks.iter().find(|c| c.1 > c.2) {
+        Some(&(name, _, _, value, x)) => Err(crate::error::SolveFailure::Inadmissible {
+            check: name.to_string(),
+            value,
+            x,
+        }),
+        None => Ok(()),
+    }
 }
 
 /// Sine-graded Gauss–Legendre rule on [−1, 1]: `u = sin(πv/2)`, nodes clustered like

@@ -397,26 +397,22 @@ fn check_normal_state(
     tol: f64,
 ) -> Result<Admissibility, SolveFailure> {
     let adm = assess_normal_state(model, state, slope);
-    if adm.min_pressure < -tol {
-        return Err(SolveFailure::Inadmissible {
-            check: "p ≥ 0".into(),
-            value: adm.min_pressure,
-            x: f64::NAN,
-        });
-    }
-    if adm.stick_excess > tol {
-        return Err(SolveFailure::Inadmissible {
-            check: "|q| ≤ η p in the stick zone".into(),
-            value: adm.stick_excess,
-            x: adm.stick_excess_at,
-        });
-    }
-    if adm.slip_reversal > tol {
-        return Err(SolveFailure::Inadmissible {
-            check: "slip in the right slip zone must run against the friction".into(),
-            value: adm.slip_reversal,
-            x: adm.slip_reversal_at,
-        });
-    }
+    super::first_violation(&[
+        ("p ≥ 0", -adm.min_pressure, tol, adm.min_pressure, f64::NAN),
+        (
+            "|q| ≤ η p in the stick zone",
+            adm.stick_excess,
+            tol,
+            adm.stick_excess,
+            adm.stick_excess_at,
+        ),
+        (
+            "slip in the right slip zone must run against the friction",
+            adm.slip_reversal,
+            tol,
+            adm.slip_reversal,
+            adm.slip_reversal_at,
+        ),
+    ])?;
     Ok(adm)
 }

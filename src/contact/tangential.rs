@@ -531,28 +531,23 @@ fn solve_geometry(
 
 fn check(adm: &StepAdmissibility, state: &ContactState, tol: f64) -> Result<(), SolveFailure> {
     let stick = state.traction.stick.as_ref().expect("slip state");
-    if adm.min_pressure < -tol {
-        return Err(SolveFailure::Inadmissible {
-            check: "p ≥ 0".into(),
-            value: adm.min_pressure,
-            x: f64::NAN,
-        });
-    }
-    if adm.stick_excess > tol {
-        return Err(SolveFailure::Inadmissible {
-            check: "|q| ≤ η p in the stick zone".into(),
-            value: adm.stick_excess,
-            x: stick.mid(),
-        });
-    }
-    if adm.slip_reversal > tol.max(1e-2) {
-        return Err(SolveFailure::Inadmissible {
-            check: "slip in the slip zones must oppose the friction".into(),
-            value: adm.slip_reversal,
-            x: f64::NAN,
-        });
-    }
-    Ok(())
+    super::first_violation(&[
+        ("p ≥ 0", -adm.min_pressure, tol, adm.min_pressure, f64::NAN),
+        (
+            "|q| ≤ η p in the stick zone",
+            adm.stick_excess,
+            tol,
+            adm.stick_excess,
+            stick.mid(),
+        ),
+        (
+            "slip in the slip zones must oppose the friction",
+            adm.slip_reversal,
+            tol.max(1e-2),
+            adm.slip_reversal,
+            f64::NAN,
+        ),
+    ])
 }
 
 /// The admissibility measures of a step from `old` to `new` (module docs).
