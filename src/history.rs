@@ -30,7 +30,7 @@ use serde::{Deserialize, Serialize};
 use crate::contact::memory::Memory;
 use crate::contact::normal::NormalLoading;
 use crate::contact::pressure::Discretisation;
-use crate::contact::tangential::{SlipOptions, SlipStep, StepAdmissibility, solve_slip};
+use crate::contact::tangential::{SlipOptions, SlipStep, StepAdmissibility, WarmStart, solve_slip};
 use crate::contact::{ContactModel, ContactState};
 use crate::error::{Issue, SolveFailure};
 
@@ -281,6 +281,8 @@ pub struct DriverState {
     last_normal_work: f64,
     /// Electric work in the last step (J/m).
     last_electric_work: f64,
+    /// Slip signs and Jacobian of the last step, the warm start of the next step of a phase.
+    warm: Option<WarmStart>,
 }
 
 impl DriverState {
@@ -303,6 +305,7 @@ impl DriverState {
             last_dissipation: 0.0,
             last_normal_work: 0.0,
             last_electric_work: 0.0,
+            warm: None,
         }
     }
 }
@@ -417,6 +420,11 @@ pub fn advance(
         q,
         sign,
         &guesses,
+        if new_phase {
+            None
+        } else {
+            driver.warm.as_ref()
+        },
         options,
     )
     .map_err(|failure| StepFailure {
@@ -446,6 +454,13 @@ pub fn advance(
         (Some(a), Some(b)) => 0.5 * (a + b) * (new.charge - old.charge),
         _ => 0.0,
     };
+    driver.warm = Some(WarmStart {
+        signs: (
+            solved.state.traction.left_sign,
+            solved.state.traction.right_sign,
+        ),
+        jacobian: solved.jacobian,
+    });
     driver.state = solved.state.clone();
     let stick = driver
         .state
@@ -525,25 +540,29 @@ pub fn step_increments(model: &ContactModel, old: &ContactState, new: &ContactSt
     let right_end = (old.centre + old.half_width).max(new.centre + new.half_width);
     let mut breaks = new.traction_breakpoints();
     breaks.extend(old.traction_breakpoints());
-    // ∫ f over [from, to] split at the traction's breakpoints.
-    let integrate = |from: f64, to: f64, f: &dyn Fn(f64) -> f64| -> f64 {
-        let (lo, hi) = (from.min(to), from.max(to));
+    // q̄ and Δε on the graded nodes of each slip zone, split at the traction's breakpoints,
+    // with the running integral of q̄ for the inner integral.
+    let table = |from: f64, to: f64| {
         let mut pts: Vec<f64> = breaks
             .iter()
             .copied()
-            .filter(|x| *x > lo && *x < hi)
+            .filter(|x| *x > from && *x < to)
             .collect();
-        pts.extend([lo, hi]);
-        let sum = crate::contact::graded_integral(pts, f);
-        if to >= from { sum } else { -sum }
+        pts.extend([from, to]);
+        crate::contact::graded_cumulative(pts, &q_mean)
     };
     // Right zone: −∫_{hi}^{R} Δε(t) ∫_t^R q̄; left zone: +∫_{L}^{lo} Δε(t) ∫_L^t q̄.
-    let right = integrate(stick.hi, right_end, &|t| {
-        d_strain(t) * integrate(t, right_end, &q_mean)
-    });
-    let left = integrate(left_end, stick.lo, &|t| {
-        d_strain(t) * integrate(left_end, t, &q_mean)
-    });
+    let right_table = table(stick.hi, right_end);
+    let right: f64 = right_table
+        .nodes
+        .iter()
+        .map(|&(t, w, _, before)| w * d_strain(t) * (right_table.total - before))
+        .sum();
+    let left: f64 = table(left_end, stick.lo)
+        .nodes
+        .iter()
+        .map(|&(t, w, _, before)| w * d_strain(t) * before)
+        .sum();
     (d_delta, -right + left)
 }
 

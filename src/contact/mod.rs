@@ -667,6 +667,53 @@ pub fn graded_integral(mut points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> f64 {
         .sum()
 }
 
+/// A function tabulated on the nodes of [`graded_integral`]'s pieces, with running integrals.
+#[derive(Debug, Clone, Default)]
+pub struct GradedTable {
+    /// `(x, weight, f(x), ∫ f from the first point to x)` for every node, in increasing x.
+    pub nodes: Vec<(f64, f64, f64, f64)>,
+    /// `∫ f` over all pieces.
+    pub total: f64,
+}
+
+/// Tabulate f on the graded rule over the pieces between `points` (as [`graded_integral`])
+/// together with the running integral up to each node, from the cumulative Gauss–Legendre
+/// matrix in the graded variable ([`crate::quadrature::gauss_legendre_cumulative`]). Nested
+/// integrals such as `∫ g(t) ∫_t^R f ds dt` then cost one evaluation of f per node.
+pub fn graded_cumulative(mut points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
+    static CUMULATIVE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
+    let (nodes, weights) = graded_rule();
+    let n = nodes.len();
+    let cumulative = CUMULATIVE.get_or_init(|| {
+        // Row k: ∫_{-1}^{v_k} h(v) dv with h = f(x(v)) x'(v), x'(v) = half (π/2) cos(πv/2).
+        let (v, _) = crate::quadrature::gauss_legendre(n);
+        let s = crate::quadrature::gauss_legendre_cumulative(n);
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        (0..n * n)
+            .map(|kj| s[kj] * half_pi * (half_pi * v[kj % n]).cos())
+            .collect()
+    });
+    points.sort_by(f64::total_cmp);
+    points.dedup();
+    let mut table = GradedTable::default();
+    for w in points.windows(2) {
+        let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+        let values: Vec<f64> = nodes.iter().map(|u| f(mid + half * u)).collect();
+        for k in 0..n {
+            let row = &cumulative[k * n..(k + 1) * n];
+            let before: f64 = half * row.iter().zip(&values).map(|(c, v)| c * v).sum::<f64>();
+            table.nodes.push((
+                mid + half * nodes[k],
+                weights[k] * half,
+                values[k],
+                table.total + before,
+            ));
+        }
+        table.total += half * weights.iter().zip(&values).map(|(w, v)| w * v).sum::<f64>();
+    }
+    table
+}
+
 /// One admissibility check: `(name, measure, allowed, reported value, x)`; it fails when
 /// `measure > allowed`.
 pub(crate) type Check<'a> = (&'a str, f64, f64, f64, f64);

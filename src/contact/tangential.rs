@@ -19,12 +19,18 @@
 //! the eccentric punch, seed eqs. 46, 52, 54) gives its own consistency and resultant for a and
 //! c; the charge follows eqs. 47, 53, 55.
 //!
-//! The implementation solves for the four geometric unknowns `(lo, hi, a, c)` together, by
-//! Newton's method with a finite-difference Jacobian; each residual evaluation solves the
-//! linear problem at fixed geometry (pressure, charge and stick traction coupled through κq,
-//! w13 w and the slip traction) by fixed-point iteration with the factored matrices. (Block
-//! Gauss–Seidel between the stick ends and (a, c), as in the seed paper, falls into 2-cycles
-//! when the contact shifts at a reversal.)
+//! The implementation solves for the four geometric unknowns `(lo, hi, a, c)` together, by a
+//! quasi-Newton method: the Jacobian is carried over from the previous step of the phase (or
+//! built by finite differences at a phase start and whenever a quasi-Newton direction fails
+//! the line search) and improved by Broyden's rank-one update after every accepted iterate.
+//! Each residual evaluation solves the linear problem at fixed geometry (pressure, charge and
+//! stick traction coupled through κq, w13 w and the slip traction) by a fixed-point iteration
+//! on the shear traction at the pressure and charge collocation points, with the factored
+//! matrices and Anderson acceleration; the parts that depend only on the geometry (the
+//! remembered strain, the inherited correction and its Cauchy transform, the slip-shape
+//! function) are evaluated once per evaluation. (Block Gauss–Seidel between the stick ends
+//! and (a, c), as in the seed paper, falls into 2-cycles when the contact shifts at a
+//! reversal.)
 //!
 //! # Inherited corrections
 //! The memory has square-root kinks at the ends of earlier stick zones (the exterior Cauchy
@@ -72,6 +78,9 @@ pub struct SlipOptions {
     pub tolerance: f64,
     /// Maximum Newton iterations.
     pub max_iterations: usize,
+    /// Maximum residual evaluations of one attempt (one sign pattern and starting guess);
+    /// converging attempts need at most ~60, attempts without a root would wander for hundreds.
+    pub max_evaluations: usize,
     /// Allowed violation of `|q| ≤ ηp` (relative to `η p0`) and of the slip direction
     /// (relative to the largest slip increment).
     pub admissibility: f64,
@@ -82,6 +91,7 @@ impl Default for SlipOptions {
         Self {
             tolerance: 1e-13,
             max_iterations: 50,
+            max_evaluations: 150,
             admissibility: 1e-3,
         }
     }
@@ -111,6 +121,10 @@ pub struct SlipStep {
     pub residual: f64,
     /// The checks.
     pub admissibility: StepAdmissibility,
+    /// The (quasi-Newton) Jacobian of the residuals with respect to `(lo, hi, a, c)` at the
+    /// end, a starting Jacobian for the next step.
+    #[serde(skip)]
+    pub jacobian: [[f64; 4]; 4],
 }
 
 /// The four geometric unknowns of a step: stick-zone ends and contact half-width and centre.
@@ -209,24 +223,50 @@ impl StepProblem<'_> {
         state.traction.friction = eta;
         state.traction.left_sign = self.signs.0;
         state.traction.right_sign = self.signs.1;
-        let mut q_old: Vec<f64> = pressure_points
+        state.traction.stick = Some(StickZone {
+            inherited: inherited.clone(),
+            ..StickZone::new(g.lo, g.hi, BoundedSeries::default(), 0.0)
+        });
+        let mixed = (self.signs.0 - self.signs.1).abs() > 0.0;
+        // The traction at the pressure and charge points is `η p S + q̃_own + q̃_inherited`;
+        // S and the inherited part depend on the geometry only, so they are evaluated once.
+        let sampled = |points: &[f64]| -> Vec<(f64, f64)> {
+            points
+                .iter()
+                .map(|&x| {
+                    let inh = inherited.as_ref().map_or(0.0, |z| z.value(x));
+                    (state.slip_shape(x), inh)
+                })
+                .collect()
+        };
+        let fixed_p = sampled(&pressure_points);
+        let fixed_c = if split.conducting {
+            sampled(&charge_points)
+        } else {
+            Vec::new()
+        };
+        let (np, nc) = (pressure_points.len(), fixed_c.len());
+        // The inner unknown: q at the pressure points, then at the charge points.
+        let mut x: Vec<f64> = pressure_points
             .iter()
+            .chain(&charge_points[..nc])
             .map(|&x| guess.traction_at(x))
             .collect();
-        let mut q_charge: Vec<f64> = charge_points
-            .iter()
-            .map(|&x| guess.traction_at(x))
-            .collect();
+        let mut fx = vec![0.0; np + nc];
         let mut rhs = vec![0.0; m + 1];
         let mut psi = vec![0.0; m];
+        let mut psi_q = vec![0.0; m];
         let mut theta = vec![0.0; m];
+        let mut srhs = vec![0.0; m + 1];
+        let mut crhs = vec![0.0; m.saturating_sub(1)];
         let scale = 1.0 / (model.radius * ystar);
         let p_scale = g.a * scale;
         let (mut lambda_p, mut lambda_q) = (0.0, 0.0);
+        let mut accel = Anderson::new(5);
         for _ in 0..100 {
             // Pressure for the current shear traction (seed eqs. 52, 54, 56).
-            for ((r, &x), q) in rhs.iter_mut().zip(&pressure_points).zip(&q_old) {
-                *r = -x * scale - kappa / ystar * q;
+            for ((r, &xp), q) in rhs.iter_mut().zip(&pressure_points).zip(&x[..np]) {
+                *r = -xp * scale - kappa / ystar * q;
             }
             lambda_p = disc.bounded.solve(&rhs, &mut psi);
             state.pressure = BoundedSeries::from_nodes(&disc.bounded, &psi);
@@ -247,56 +287,58 @@ impl StepProblem<'_> {
                 state.charge = charge;
                 state.potential = potential;
                 let free = charge - model.pressure_charge(self.normal_load);
-                let crhs: Vec<f64> = q_charge.iter().map(|q| -e.w13 / e.y33 * q).collect();
+                for (r, q) in crhs.iter_mut().zip(&x[np..]) {
+                    *r = -e.w13 / e.y33 * q;
+                }
                 disc.unbounded.solve(&crhs, free / g.a, &mut theta);
                 state.potential_charge = UnboundedSeries::from_nodes(&disc.unbounded, &theta);
             }
             // Stick traction (seed eqs. 50–51/58–59, 60, 63); `H'(pS)` is `s H'p` when both slip
             // zones have the sign s.
-            state.traction.stick = Some(StickZone::new(g.lo, g.hi, BoundedSeries::default(), 0.0));
-            state.tabulate_shape();
-            let srhs: Vec<f64> = stick_points
-                .iter()
-                .zip(&fixed)
-                .map(|(&x, f)| {
-                    let tau = (x - g.c) / g.a;
-                    f + (local * state.pressure_at(x) + w13 * state.potential_charge.density(tau)
-                        - eta * y11 * state.shape_cauchy(x))
-                        / y11
-                })
-                .collect();
-            let mut psi_q = vec![0.0; m];
+            if mixed {
+                state.tabulate_shape();
+            }
+            for ((r, &xs), f) in srhs.iter_mut().zip(&stick_points).zip(&fixed) {
+                let tau = (xs - g.c) / g.a;
+                let shape = if mixed {
+                    state.shape_cauchy(xs)
+                } else {
+                    self.signs.0 * state.pressure.cauchy(tau)
+                };
+                *r = f
+                    + (local * state.pressure.density(tau)
+                        + w13 * state.potential_charge.density(tau)
+                        - eta * y11 * shape)
+                        / y11;
+            }
             lambda_q = disc.bounded.solve(&srhs, &mut psi_q);
-            state.traction.stick = Some(StickZone {
-                inherited: inherited.clone(),
-                ..StickZone::new(
-                    g.lo,
-                    g.hi,
-                    BoundedSeries::from_nodes(&disc.bounded, &psi_q),
-                    0.0,
-                )
-            });
-            let q_new: Vec<f64> = pressure_points
-                .iter()
-                .map(|&x| state.traction_at(x))
-                .collect();
+            let own = BoundedSeries::from_nodes(&disc.bounded, &psi_q);
+            let (mid, half) = (0.5 * (g.lo + g.hi), 0.5 * (g.hi - g.lo));
+            let q_at = |xq: f64, (shape, inh): (f64, f64)| {
+                eta * state.pressure.density((xq - g.c) / g.a) * shape
+                    + own.density((xq - mid) / half)
+                    + inh
+            };
+            for (k, &xq) in pressure_points.iter().enumerate() {
+                fx[k] = q_at(xq, fixed_p[k]);
+            }
+            for (k, &xq) in charge_points[..nc].iter().enumerate() {
+                fx[np + k] = q_at(xq, fixed_c[k]);
+            }
+            if let Some(stick) = state.traction.stick.as_mut() {
+                stick.correction = own;
+            }
             let p0 = state.pressure_at(g.c).abs().max(1e-300);
-            let change = q_new
+            let change = fx
                 .iter()
-                .zip(&q_old)
+                .zip(&x)
                 .map(|(n, o)| (n - o).abs())
                 .fold(0.0, f64::max)
                 / (eta * p0);
-            q_old = q_new;
-            if split.conducting {
-                q_charge = charge_points
-                    .iter()
-                    .map(|&x| state.traction_at(x))
-                    .collect();
-            }
             if kappa == 0.0 && !split.conducting || change < 1e-14 {
                 break;
             }
+            accel.next(&mut x, &fx);
         }
         state.shape_table = None;
         let p0 = state.pressure_at(g.c).abs().max(1e-300);
@@ -317,6 +359,102 @@ impl StepProblem<'_> {
         ];
         Ok((residual, state))
     }
+}
+
+/// Anderson acceleration (type II) of a fixed-point iteration `x ← F(x)`: the next iterate
+/// combines the last `depth` values of F so that the combined residual `F(x) − x` is least
+/// squares. For the affine map of the inner iteration it converges in a few steps where the
+/// plain iteration contracts only by the coupling factor per step.
+struct Anderson {
+    depth: usize,
+    /// Previous `x` and `F(x)`.
+    last: Option<(Vec<f64>, Vec<f64>)>,
+    /// Differences of residuals and of F values, newest last.
+    d_res: Vec<Vec<f64>>,
+    d_f: Vec<Vec<f64>>,
+}
+
+impl Anderson {
+    fn new(depth: usize) -> Self {
+        Self {
+            depth,
+            last: None,
+            d_res: Vec::new(),
+            d_f: Vec::new(),
+        }
+    }
+
+    /// Replace `x` by the next iterate given `fx = F(x)`.
+    fn next(&mut self, x: &mut [f64], fx: &[f64]) {
+        let res: Vec<f64> = fx.iter().zip(x.iter()).map(|(f, v)| f - v).collect();
+        if let Some((x_old, f_old)) = self.last.take() {
+            let r_old: Vec<f64> = f_old.iter().zip(&x_old).map(|(f, v)| f - v).collect();
+            self.d_res
+                .push(res.iter().zip(&r_old).map(|(a, b)| a - b).collect());
+            self.d_f
+                .push(fx.iter().zip(&f_old).map(|(a, b)| a - b).collect());
+            if self.d_res.len() > self.depth {
+                self.d_res.remove(0);
+                self.d_f.remove(0);
+            }
+        }
+        self.last = Some((x.to_vec(), fx.to_vec()));
+        x.copy_from_slice(fx);
+        let k = self.d_res.len();
+        if k == 0 {
+            return;
+        }
+        // Normal equations of min |res − ΔR γ| (k ≤ depth), lightly regularised.
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(u, v)| u * v).sum::<f64>();
+        let gram: Vec<Vec<f64>> = self
+            .d_res
+            .iter()
+            .map(|di| {
+                let mut row: Vec<f64> = self.d_res.iter().map(|dj| dot(di, dj)).collect();
+                row.push(dot(di, &res));
+                row
+            })
+            .collect();
+        let mut gram = gram;
+        let trace: f64 = (0..k).map(|i| gram[i][i]).sum::<f64>().max(1e-300);
+        for (i, row) in gram.iter_mut().enumerate() {
+            row[i] += 1e-12 * trace;
+        }
+        let Some(gamma) = solve_small(gram) else {
+            return;
+        };
+        for (i, gi) in gamma.iter().enumerate() {
+            for (v, d) in x.iter_mut().zip(&self.d_f[i]) {
+                *v -= gi * d;
+            }
+        }
+    }
+}
+
+/// Solve a small dense system given as rows `[A | b]` by Gaussian elimination with partial
+/// pivoting.
+#[allow(clippy::needless_range_loop)]
+fn solve_small(mut rows: Vec<Vec<f64>>) -> Option<Vec<f64>> {
+    let n = rows.len();
+    for col in 0..n {
+        let piv = (col..n).max_by(|&x, &y| rows[x][col].abs().total_cmp(&rows[y][col].abs()))?;
+        if rows[piv][col].abs() < 1e-300 {
+            return None;
+        }
+        rows.swap(col, piv);
+        for row in col + 1..n {
+            let f = rows[row][col] / rows[col][col];
+            for k in col..=n {
+                rows[row][k] -= f * rows[col][k];
+            }
+        }
+    }
+    let mut x = vec![0.0; n];
+    for row in (0..n).rev() {
+        let s: f64 = (row + 1..n).map(|k| rows[row][k] * x[k]).sum();
+        x[row] = (rows[row][n] - s) / rows[row][row];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 fn norm(r: &[f64; 4]) -> f64 {
@@ -350,6 +488,15 @@ fn solve4(mut j: [[f64; 4]; 4], r: [f64; 4]) -> Option<[f64; 4]> {
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
+/// What a step passes to the next one of the same phase: its slip signs and Jacobian.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WarmStart {
+    /// Slip signs of the left and right slip zones.
+    pub signs: (f64, f64),
+    /// Jacobian of the residuals with respect to `(lo, hi, a, c)`.
+    pub jacobian: [[f64; 4]; 4],
+}
+
 /// Solve one step at tangential load `tangential_load` with slip sign `sign`, starting from
 /// `start` (the previous step), stick-zone guesses tried in turn and the phase's inherited
 /// correction chain `base`.
@@ -363,6 +510,7 @@ pub fn solve_slip(
     tangential_load: f64,
     sign: f64,
     guesses_in: &[(f64, f64)],
+    warm: Option<&WarmStart>,
     options: SlipOptions,
 ) -> Result<SlipStep, SolveFailure> {
     let guess = guesses_in[0];
@@ -381,29 +529,58 @@ pub fn solve_slip(
         .into_iter()
         .filter(|&x| x > guess.0.min(c - a) - a && x < guess.1.max(c + a) + a)
         .collect();
-    let mut guesses = guesses_in.to_vec();
+    let mut guesses: Vec<(f64, f64)> = Vec::new();
+    let mut candidates = guesses_in.to_vec();
     for i in 0..breaks.len() / 2 {
         let (l, r) = (breaks[i], breaks[breaks.len() - 1 - i]);
         if r - l > 2.0 * inset && l > c - a && r < c + a {
-            guesses.push((l + inset, r - inset));
+            candidates.push((l + inset, r - inset));
         }
     }
+    // Other pairs of remembered boundaries (an earlier turning point's zone need not be
+    // nested symmetrically in the breakpoint list), widest first.
+    let mut pairs: Vec<(f64, f64)> = Vec::new();
+    for (i, &l) in breaks.iter().enumerate() {
+        for &r in &breaks[i + 1..] {
+            if r - l > 2.0 * inset && l > c - a && r < c + a {
+                pairs.push((l + inset, r - inset));
+            }
+        }
+    }
+    pairs.sort_by(|x, y| (y.1 - y.0).total_cmp(&(x.1 - x.0)));
+    candidates.extend(pairs);
+    for g in candidates {
+        let same = |h: &(f64, f64)| (h.0 - g.0).abs().max((h.1 - g.1).abs()) <= 1e-12 * a;
+        if !guesses.iter().any(same) {
+            guesses.push(g);
+        }
+    }
+    // Every sign pattern and guess is tried with the fast quasi-Newton iteration first; the
+    // jumps above are where it can miss a root that Newton's method finds, so Newton's method
+    // is the fallback.
     let mut first_failure = None;
-    for signs in [(sign, sign), (-sign, sign), (sign, -sign)] {
-        for &guess in &guesses {
-            let problem = StepProblem {
-                model,
-                disc,
-                memory,
-                base,
-                signs,
-                normal_load: start.normal_load,
-                tangential_load,
-            };
-            match solve_geometry(&problem, start, guess, options) {
-                Ok(step) => return Ok(step),
-                Err(e) => {
-                    first_failure.get_or_insert(e);
+    for newton in [false, true] {
+        for signs in [(sign, sign), (-sign, sign), (sign, -sign)] {
+            for &guess in &guesses {
+                let problem = StepProblem {
+                    model,
+                    disc,
+                    memory,
+                    base,
+                    signs,
+                    normal_load: start.normal_load,
+                    tangential_load,
+                };
+                let method = if newton {
+                    Method::Newton
+                } else {
+                    Method::Broyden(warm.filter(|w| w.signs == signs).map(|w| w.jacobian))
+                };
+                match solve_geometry(&problem, start, guess, method, options) {
+                    Ok(step) => return Ok(step),
+                    Err(e) => {
+                        first_failure.get_or_insert(e);
+                    }
                 }
             }
         }
@@ -411,13 +588,80 @@ pub fn solve_slip(
     Err(first_failure.expect("at least one attempt"))
 }
 
+/// Finite-difference Jacobian of the residuals at `g` (the inherited correction of the base
+/// point is kept so that the differences do not straddle a switch of the chain).
+#[allow(clippy::needless_range_loop)]
+fn fd_jacobian(
+    problem: &StepProblem<'_>,
+    g: &Geometry,
+    r: &[f64; 4],
+    state: &ContactState,
+) -> Result<[[f64; 4]; 4], SolveFailure> {
+    // Steps well above evaluation noise, well inside the contact (the residuals have
+    // square-root behaviour at its ends).
+    let room = (g.lo - (g.c - g.a)).min(g.c + g.a - g.hi);
+    let d = (1e-6 * g.a).min(0.1 * room).max(1e-10 * g.a);
+    let mut jac = [[0.0; 4]; 4];
+    for k in 0..4 {
+        let mut gk = *g;
+        let step = match k {
+            0 => {
+                gk.lo += d;
+                d
+            }
+            1 => {
+                gk.hi -= d;
+                -d
+            }
+            2 => {
+                gk.a += d;
+                d
+            }
+            _ => {
+                gk.c += d;
+                d
+            }
+        };
+        let chosen = state
+            .traction
+            .stick
+            .as_ref()
+            .and_then(|z| z.inherited.clone());
+        let (rk, _) = problem.evaluate_with(&gk, state, chosen)?;
+        for i in 0..4 {
+            jac[i][k] = (rk[i] - r[i]) / step;
+        }
+    }
+    Ok(jac)
+}
+
+/// How the geometry is iterated.
+#[derive(Debug, Clone, Copy)]
+enum Method {
+    /// Broyden's updates from the given Jacobian (or a finite-difference one), within the
+    /// evaluation budget.
+    Broyden(Option<[[f64; 4]; 4]>),
+    /// Newton's method with a finite-difference Jacobian at every iterate and no evaluation
+    /// budget: slower, and the fallback where the quasi-Newton attempts all fail.
+    Newton,
+}
+
+/// Newton's method on the geometry with Broyden's rank-one updates: the Jacobian is taken
+/// from `hint` (the previous step's, when the sign pattern is the same) or by finite
+/// differences, updated after every accepted step, and recomputed by finite differences
+/// only when a quasi-Newton direction fails the line search.
 #[allow(clippy::needless_range_loop)]
 fn solve_geometry(
     problem: &StepProblem<'_>,
     start: &ContactState,
     guess: (f64, f64),
+    method: Method,
     options: SlipOptions,
 ) -> Result<SlipStep, SolveFailure> {
+    let (hint, broyden) = match method {
+        Method::Broyden(hint) => (hint, true),
+        Method::Newton => (None, false),
+    };
     let model = problem.model;
     let (a0, c0) = (start.half_width, start.centre);
     let clamp_lo = |lo: f64| lo.max(c0 - a0 * (1.0 - 1e-9));
@@ -434,6 +678,8 @@ fn solve_geometry(
     }
     let (mut r, mut state) = problem.evaluate(&g, start)?;
     let mut evaluations = 1;
+    let mut jac = hint;
+    let mut fresh = false;
     for iter in 0..options.max_iterations {
         let size = norm(&r);
         if size < options.tolerance {
@@ -449,6 +695,9 @@ fn solve_geometry(
                 state.charge = charge;
                 state.potential = potential;
             }
+            // The accepted state is evaluated many times from here on (checks, increments,
+            // memory): tabulate its shape quadrature once.
+            state.tabulate_shape();
             let admissibility = assess_step(model, start, &state);
             check(&admissibility, &state, options.admissibility)?;
             return Ok(SlipStep {
@@ -457,48 +706,30 @@ fn solve_geometry(
                 newton_iterations: evaluations,
                 residual: size,
                 admissibility,
+                jacobian: jac.unwrap_or([[0.0; 4]; 4]),
             });
         }
-        // Finite-difference Jacobian: steps well above evaluation noise, well inside the
-        // contact (the residuals have square-root behaviour at its ends).
-        let room = (g.lo - (g.c - g.a)).min(g.c + g.a - g.hi);
-        let d = (1e-6 * g.a).min(0.1 * room).max(1e-10 * g.a);
-        let mut jac = [[0.0; 4]; 4];
-        for k in 0..4 {
-            let mut gk = g;
-            let step = match k {
-                0 => {
-                    gk.lo += d;
-                    d
-                }
-                1 => {
-                    gk.hi -= d;
-                    -d
-                }
-                2 => {
-                    gk.a += d;
-                    d
-                }
-                _ => {
-                    gk.c += d;
-                    d
-                }
-            };
-            let chosen = state
-                .traction
-                .stick
-                .as_ref()
-                .and_then(|z| z.inherited.clone());
-            let (rk, _) = problem.evaluate_with(&gk, &state, chosen)?;
-            evaluations += 1;
-            for i in 0..4 {
-                jac[i][k] = (rk[i] - r[i]) / step;
-            }
+        if broyden && evaluations > options.max_evaluations {
+            break;
         }
-        let Some(dx) = solve4(jac, r) else { break };
+        let j = match jac {
+            Some(j) => j,
+            None => {
+                evaluations += 4;
+                fresh = true;
+                fd_jacobian(problem, &g, &r, &state)?
+            }
+        };
+        let Some(dx) = solve4(j, r) else {
+            if fresh {
+                break;
+            }
+            jac = None;
+            continue;
+        };
         let mut alpha = 1.0;
-        let mut accepted = false;
-        for _ in 0..30 {
+        let mut accepted = None;
+        for _ in 0..if fresh { 30 } else { 6 } {
             let gn = Geometry {
                 lo: g.lo + alpha * dx[0],
                 hi: g.hi + alpha * dx[1],
@@ -509,18 +740,35 @@ fn solve_geometry(
                 let (rn, sn) = problem.evaluate(&gn, &state)?;
                 evaluations += 1;
                 if norm(&rn) < (1.0 - 1e-4 * alpha) * size {
-                    g = gn;
-                    r = rn;
-                    state = sn;
-                    accepted = true;
+                    accepted = Some((gn, rn, sn, alpha));
                     break;
                 }
             }
             alpha *= 0.5;
         }
-        if !accepted {
-            break;
+        let Some((gn, rn, sn, alpha)) = accepted else {
+            if fresh {
+                break;
+            }
+            jac = None;
+            continue;
+        };
+        // Broyden's update with the step taken and the change of the residuals.
+        let step = dx.map(|v| alpha * v);
+        let step2: f64 = step.iter().map(|v| v * v).sum();
+        let mut updated = j;
+        for i in 0..4 {
+            let predicted: f64 = (0..4).map(|k| j[i][k] * step[k]).sum();
+            let miss = rn[i] - r[i] - predicted;
+            for k in 0..4 {
+                updated[i][k] += miss * step[k] / step2;
+            }
         }
+        jac = broyden.then_some(updated);
+        fresh = false;
+        g = gn;
+        r = rn;
+        state = sn;
     }
     Err(SolveFailure::NoConvergence {
         what: "tangential step (Newton on stick ends, a, c)",
