@@ -314,6 +314,20 @@ pub fn run_with(
     out_dir: &Path,
     observer: &mut dyn crate::history::Observer,
 ) -> Result<RunResult, Error> {
+    match run_partial(scenario, out_dir, observer)? {
+        (result, None) => Ok(result),
+        (_, Some(failure)) => Err(failure),
+    }
+}
+
+/// As [`run_with`], but a solver failure during the history is returned beside what was
+/// written (the summary and the fields reached) instead of replacing it. Errors before the
+/// history (normal loading, writing) are returned as `Err`.
+pub fn run_partial(
+    scenario: &Scenario,
+    out_dir: &Path,
+    observer: &mut dyn crate::history::Observer,
+) -> Result<(RunResult, Option<Error>), Error> {
     let model = &scenario.model;
     let disc = Discretisation::new(scenario.collocation_points);
     let normal = solve_normal(model, &disc, scenario.normal_load, NormalOptions::default())
@@ -520,14 +534,14 @@ pub fn run_with(
     match result {
         Ok(()) => {
             let out_dir = staging.commit()?;
-            match failure {
-                Some(e) => Err(e),
-                None => Ok(RunResult {
+            Ok((
+                RunResult {
                     out_dir,
                     summary,
                     fields,
-                }),
-            }
+                },
+                failure,
+            ))
         }
         Err(e) => {
             staging.abandon();
@@ -1092,10 +1106,13 @@ pub fn sweep(
         .par_iter()
         .map(|(i, _, sc)| {
             let outcome = if options.runs {
-                match run(sc, &out_dir.join(variant_dir(*i))) {
-                    Ok(r) => VariantOutcome {
+                let dir = out_dir.join(variant_dir(*i));
+                match run_partial(sc, &dir, &mut crate::history::NoObserver) {
+                    // A history that stops part-way keeps its normal loading and the fields
+                    // reached.
+                    Ok((r, error)) => VariantOutcome {
                         normal: Some(r.summary.normal_loading),
-                        error: None,
+                        error,
                         fields: r.fields,
                     },
                     Err(e) => VariantOutcome {

@@ -883,6 +883,100 @@ fn sweep_with_runs_keeps_each_variant_and_compares_the_fields() {
     assert!(svg.contains("friction = 0.2") && svg.contains("friction = 0.3"));
 }
 
+/// A history the solver cannot finish: the Figure-3 history at M = 16 (too coarse for PZT-4;
+/// the step at t = 2.3 s, on the way from A to C, fails, measured). If the core learns to
+/// solve it, this test needs another failing input.
+fn failing_history() -> String {
+    r#"{
+  "name": "fails",
+  "material": { "kind": "preset", "name": "pzt4" },
+  "punch": { "radius": 0.06, "electrode": { "kind": "conducting", "charge": 6e-7 } },
+  "friction": 0.3,
+  "normal_load": 2000.0,
+  "numerics": { "collocation_points": 16 },
+  "tangential_history": { "points": [[0.0, 0.0], [1.0, 0.3], [2.0, 0.5], [3.0, 0.3]] },
+  "output": { "snapshots": [1.0, 2.0, 3.0], "field_points": 40 }
+}"#
+    .to_string()
+}
+
+/// A solver failure exits 1 and keeps what was solved: `failure.json` with the error and the
+/// last accepted step, `steps.csv` up to it, the snapshots reached, the plots and a warning for
+/// the snapshot not reached. In a sweep with `--runs` the failed variant keeps its
+/// normal-loading row, its error and its curves at the instants it reached.
+#[test]
+fn solver_failure_exits_1_and_keeps_the_steps_solved() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("fails.json");
+    std::fs::write(&file, failing_history()).unwrap();
+    let out = tmp.path().join("out");
+    let o = fretsim()
+        .arg("run")
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("step "));
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Failure {
+        error: String,
+        last_accepted_step: serde_json::Value,
+    }
+    let f: Failure =
+        serde_json::from_str(&std::fs::read_to_string(out.join("failure.json")).unwrap()).unwrap();
+    let s = read_summary(&out);
+    let h = s.history.as_ref().unwrap();
+    assert_eq!(h.failure.as_deref(), Some(f.error.as_str()));
+    let last = f.last_accepted_step["step"].as_u64().unwrap() as usize;
+    assert_eq!(h.steps, last);
+    assert!(
+        last >= 20,
+        "the failure comes after A (step 20), got {last}"
+    );
+    let (header, rows) = read_csv(&out.join("steps.csv"));
+    assert_eq!((header.as_str(), rows.len()), (STEPS_HEADER, last + 1));
+    assert_eq!(
+        s.snapshots.iter().map(|x| x.t).collect::<Vec<_>>(),
+        [1.0, 2.0]
+    );
+    assert!(out.join("fields/t_2.000000.csv").exists());
+    assert!(!out.join("fields/t_3.000000.csv").exists());
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("snapshot t = 3 s was not reached"))
+    );
+    assert_svg(&out.join("plots/hysteresis.svg"), 1);
+    assert_svg(&out.join("plots/snapshots_q.svg"), 2);
+    // The same file as a one-variant sweep with runs.
+    let sw = tmp.path().join("sw");
+    let o = fretsim()
+        .arg("sweep")
+        .arg(&file)
+        .args(["--quiet", "--runs", "--vary", "friction=0.3:0.3:1", "--out"])
+        .arg(&sw)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "a failed variant does not fail the sweep"
+    );
+    let text = std::fs::read_to_string(sw.join("sweep.csv")).unwrap();
+    let row = text.lines().nth(1).unwrap();
+    assert!(
+        row.contains("did not converge") || row.contains("inadmissible"),
+        "{row}"
+    );
+    let (_, rows) = read_csv(&sw.join("sweep.csv"));
+    assert!((rows[0][2] - s.normal_loading.half_width).abs() < 1e-15);
+    assert!(sw.join("variant_0000/failure.json").exists());
+    assert_svg(&sw.join("plots/compare_t_2.000000_q.svg"), 1);
+    assert!(!sw.join("plots/compare_t_3.000000_q.svg").exists());
+}
+
 #[test]
 fn unwritable_output_path_exits_2_and_names_it() {
     let tmp = tempfile::tempdir().unwrap();
