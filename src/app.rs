@@ -61,6 +61,9 @@ pub struct NormalSummary {
     pub outside_gap: crate::contact::GapReport,
     /// Charge carried by the pressure, Γ1 = kP (C/m).
     pub pressure_charge: f64,
+    /// q/(ηp) in the right slip zone: +1 when the friction points outward, −1 inward (which
+    /// happens below Γ1 for a conducting punch); 0 without slip zones.
+    pub right_slip_sign: f64,
 }
 
 /// `summary.json`.
@@ -72,10 +75,16 @@ pub struct Summary {
     pub scenario: RawScenario,
     /// Derived constants.
     pub derived: Derived,
+    /// The inputs as the solver used them.
+    pub resolved: Resolved,
     /// Normal-loading results.
     pub normal_loading: NormalSummary,
     /// Tangential history results (absent without a history).
     pub history: Option<HistorySummary>,
+    /// The field snapshots written at the requested times.
+    pub snapshots: Vec<SnapshotSummary>,
+    /// Work counters and checks.
+    pub solver: SolverStatistics,
     /// Warnings.
     pub warnings: Vec<String>,
 }
@@ -87,6 +96,8 @@ pub struct RunResult {
     pub out_dir: PathBuf,
     /// Summary (as written).
     pub summary: Summary,
+    /// The sampled fields: the end of normal loading, then one set per snapshot time.
+    pub fields: Vec<FieldSet>,
 }
 
 /// Derived constants of a model at normal load P.
@@ -130,6 +141,7 @@ fn normal_summary(model: &ContactModel, n: &NormalLoading) -> NormalSummary {
         admissibility: n.admissibility,
         outside_gap: model.outside_gap(s),
         pressure_charge: model.pressure_charge(s.normal_load),
+        right_slip_sign: s.traction.right_sign,
     }
 }
 
@@ -157,12 +169,165 @@ pub struct HistorySummary {
     pub verdict_tolerance: f64,
 }
 
+/// Inputs as the solver used them: a preset resolved to its constants, and the load history
+/// in N/m with the cycle block expanded and the snapshot points added.
+#[derive(Debug, Serialize)]
+pub struct Resolved {
+    /// Material constants.
+    pub material: crate::material::Material,
+    /// The load history (absent without one).
+    pub load_history: Option<crate::history::LoadHistory>,
+}
+
+/// Work counters and checks of the whole run, in `summary.json`.
+#[derive(Debug, Serialize)]
+pub struct SolverStatistics {
+    /// Collocation nodes M per interval.
+    pub collocation_points: usize,
+    /// Block iterations of the normal-loading solve.
+    pub normal_loading_iterations: usize,
+    /// Accepted load steps after normal loading.
+    pub history_steps: usize,
+    /// Newton iterations summed over the history (`newton_iterations` in `steps.csv`).
+    pub newton_iterations: usize,
+    /// Most Newton iterations in one step.
+    pub max_newton_iterations: usize,
+    /// Residual evaluations summed over the history (`evaluations` in `steps.csv`).
+    pub residual_evaluations: usize,
+    /// Largest final residual of a step.
+    pub max_residual: Option<f64>,
+    /// Worst `stick_excess` of a step (≤ 0 when admissible).
+    pub worst_stick_excess: Option<f64>,
+    /// Worst `slip_reversal` of a step (≤ 0 when admissible).
+    pub worst_slip_reversal: Option<f64>,
+}
+
+/// A field snapshot at a requested time, in `summary.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SnapshotSummary {
+    /// Requested time (s), from `output.snapshots`.
+    pub t: f64,
+    /// The field file, relative to the output folder.
+    pub file: String,
+    /// The step solved at that time.
+    pub step: usize,
+    /// Time of that step (s); equals `t` within the scenario's time tolerance.
+    pub step_t: f64,
+    /// Tangential load Q (N/m).
+    pub q: f64,
+    /// Q/(ηP).
+    pub q_over_limit: f64,
+    /// Regime of the step.
+    pub regime: crate::history::Regime,
+    /// Phase of the step.
+    pub phase: usize,
+    /// Contact half-width a (m).
+    pub half_width: f64,
+    /// Eccentricity e = −c (m).
+    pub eccentricity: f64,
+    /// Stick-zone left end (m).
+    pub stick_lo: f64,
+    /// Stick-zone right end (m).
+    pub stick_hi: f64,
+}
+
+/// Sampled surface fields of one instant: a field file and a curve of the plots.
+#[derive(Debug, Clone)]
+pub struct FieldSet {
+    /// File stem under `fields/` (`normal_loading`, `t_2.000000`).
+    pub stem: String,
+    /// Legend label.
+    pub label: String,
+    /// The samples.
+    pub points: Vec<SurfacePoint>,
+}
+
+/// Keeps, while the history runs, the states that the field files need: the turning points
+/// (the last step of each phase), the last step, and the steps at the snapshot times.
+struct Snapshots<'a> {
+    inner: &'a mut dyn crate::history::Observer,
+    previous: Option<(crate::history::StepRecord, crate::contact::ContactState)>,
+    kept: Vec<(crate::history::StepRecord, crate::contact::ContactState)>,
+    times: &'a [f64],
+    tolerance: f64,
+    at_times: Vec<Option<(crate::history::StepRecord, crate::contact::ContactState)>>,
+}
+
+impl crate::history::Observer for Snapshots<'_> {
+    fn on_step(
+        &mut self,
+        record: &crate::history::StepRecord,
+        state: &crate::contact::ContactState,
+    ) {
+        if let Some((prev, prev_state)) = self.previous.take()
+            && prev.phase != record.phase
+            && prev.phase > 0
+        {
+            self.kept.push((prev, prev_state));
+        }
+        self.previous = Some((record.clone(), state.clone()));
+        // The last step at a snapshot time wins (a ramp to a non-zero first point is solved
+        // in several steps at the same time).
+        for (t, slot) in self.times.iter().zip(self.at_times.iter_mut()) {
+            if (record.t - t).abs() <= self.tolerance {
+                *slot = Some((record.clone(), state.clone()));
+            }
+        }
+        self.inner.on_step(record, state);
+    }
+
+    fn on_phase(&mut self, phase: usize, memory: &crate::contact::memory::Memory) {
+        self.inner.on_phase(phase, memory);
+    }
+}
+
+fn solver_statistics(
+    scenario: &Scenario,
+    normal: &NormalLoading,
+    records: &[crate::history::StepRecord],
+) -> SolverStatistics {
+    let steps = records.iter().skip(1);
+    let max = |f: &dyn Fn(&crate::history::StepRecord) -> f64| {
+        records
+            .iter()
+            .skip(1)
+            .map(f)
+            .filter(|x| x.is_finite())
+            .reduce(f64::max)
+    };
+    SolverStatistics {
+        collocation_points: scenario.collocation_points,
+        normal_loading_iterations: normal.iterations,
+        history_steps: records.len().saturating_sub(1),
+        newton_iterations: steps.clone().map(|r| r.iterations).sum(),
+        max_newton_iterations: steps.clone().map(|r| r.iterations).max().unwrap_or(0),
+        residual_evaluations: steps.map(|r| r.newton_iterations).sum(),
+        max_residual: max(&|r| r.residual),
+        worst_stick_excess: max(&|r| r.admissibility.stick_excess),
+        worst_slip_reversal: max(&|r| r.admissibility.slip_reversal),
+    }
+}
+
 /// As [`run`], reporting each accepted step to `observer` (progress bars).
 pub fn run_with(
     scenario: &Scenario,
     out_dir: &Path,
     observer: &mut dyn crate::history::Observer,
 ) -> Result<RunResult, Error> {
+    match run_partial(scenario, out_dir, observer)? {
+        (result, None) => Ok(result),
+        (_, Some(failure)) => Err(failure),
+    }
+}
+
+/// As [`run_with`], but a solver failure during the history is returned beside what was
+/// written (the summary and the fields reached) instead of replacing it. Errors before the
+/// history (normal loading, writing) are returned as `Err`.
+pub fn run_partial(
+    scenario: &Scenario,
+    out_dir: &Path,
+    observer: &mut dyn crate::history::Observer,
+) -> Result<(RunResult, Option<Error>), Error> {
     let model = &scenario.model;
     let disc = Discretisation::new(scenario.collocation_points);
     let normal = solve_normal(model, &disc, scenario.normal_load, NormalOptions::default())
@@ -188,6 +353,9 @@ pub fn run_with(
         inner: observer,
         previous: None,
         kept: Vec::new(),
+        times: &scenario.snapshots,
+        tolerance: scenario.time_tolerance,
+        at_times: vec![None; scenario.snapshots.len()],
     };
     if let Some(history) = &scenario.history {
         match crate::history::run_history(
@@ -209,6 +377,9 @@ pub fn run_with(
             }
         }
     }
+    let limit = model.friction * scenario.normal_load;
+    let tolerance = scenario.raw.numerics.cycle_tolerance;
+    let (cycles, verdict) = analyse_cycles(&records, tolerance);
     let history_summary = scenario.history.as_ref().map(|_| {
         let turning_points = records
             .windows(2)
@@ -216,89 +387,161 @@ pub fn run_with(
             .map(|w| w[0].clone())
             .chain(records.last().filter(|r| r.phase > 0).cloned())
             .collect();
-        let tolerance = scenario.raw.numerics.cycle_tolerance;
-        let (cycles, verdict) = analyse_cycles(&records, tolerance);
         HistorySummary {
             steps: records.len().saturating_sub(1),
             phases: records.last().map_or(0, |r| r.phase),
             turning_points,
             failure: failure.as_ref().map(|e| e.to_string()),
-            cycles,
+            cycles: cycles.clone(),
             verdict,
             verdict_tolerance: tolerance,
         }
     });
+    // Sampled fields: the end of normal loading, then each snapshot time reached.
+    let n = scenario.raw.output.field_points;
+    let sample = |state: &crate::contact::ContactState| -> Vec<SurfacePoint> {
+        field_points(state.centre, state.half_width, n)
+            .into_iter()
+            .map(|x| model.surface_point(state, x))
+            .collect()
+    };
+    let mut fields = vec![FieldSet {
+        stem: "normal_loading".into(),
+        label: "end of normal loading".into(),
+        points: sample(&normal.state),
+    }];
+    let mut snapshot_rows = Vec::new();
+    for (&t, kept) in scenario.snapshots.iter().zip(&snapshots.at_times) {
+        let stem = crate::scenario::snapshot_stem(t);
+        match kept {
+            Some((rec, state)) => {
+                fields.push(FieldSet {
+                    label: format!("t = {t} s, Q/(ηP) = {:.3}", rec.q / limit),
+                    stem: stem.clone(),
+                    points: sample(state),
+                });
+                snapshot_rows.push(SnapshotSummary {
+                    t,
+                    file: format!("fields/{stem}.csv"),
+                    step: rec.step,
+                    step_t: rec.t,
+                    q: rec.q,
+                    q_over_limit: rec.q / limit,
+                    regime: rec.regime,
+                    phase: rec.phase,
+                    half_width: rec.half_width,
+                    eccentricity: rec.eccentricity,
+                    stick_lo: rec.stick_lo,
+                    stick_hi: rec.stick_hi,
+                });
+            }
+            None => warnings.push(format!(
+                "snapshot t = {t} s was not reached (the history stopped at t = {} s); fields/{stem}.csv is not written",
+                records.last().map_or(f64::NAN, |r| r.t)
+            )),
+        }
+    }
     let summary = Summary {
         fretsim_version: env!("CARGO_PKG_VERSION"),
         scenario: scenario.raw.clone(),
+        resolved: Resolved {
+            material: model.material,
+            load_history: scenario.history.clone(),
+        },
         derived: derived(model, scenario.normal_load),
         normal_loading: normal_summary(model, &normal),
         history: history_summary,
+        snapshots: snapshot_rows,
+        solver: solver_statistics(scenario, &normal, &records),
         warnings,
     };
-    let points: Vec<SurfacePoint> = field_points(normal.state.centre, normal.state.half_width, 400)
-        .into_iter()
-        .map(|x| model.surface_point(&normal.state, x))
-        .collect();
+    // Turning points and the last step, unless switched off.
+    let mut turning: Vec<&(crate::history::StepRecord, crate::contact::ContactState)> = Vec::new();
+    if scenario.raw.output.turning_point_fields {
+        turning.extend(snapshots.kept.iter());
+        turning.extend(snapshots.previous.iter());
+    }
     let staging = Staging::new(out_dir)?;
+    let mut written = Vec::new();
     let result = (|| {
-        staging.write(
-            "summary.json",
+        let mut put = |name: String, bytes: &[u8]| -> Result<(), Error> {
+            staging.write(&name, bytes)?;
+            written.push(name);
+            Ok(())
+        };
+        put(
+            "summary.json".into(),
             &serde_json::to_vec_pretty(&summary).expect("summary serialises"),
         )?;
-        staging.write("fields/normal_loading.csv", &fields_csv(&points))?;
         if scenario.history.is_some() {
-            staging.write(
-                "steps.csv",
-                &steps_csv(&records, model.friction * scenario.normal_load),
-            )?;
-            staging.write(
-                "cycles.csv",
-                &cycles_csv(&analyse_cycles(&records, scenario.raw.numerics.cycle_tolerance).0),
-            )?;
+            put("steps.csv".into(), &steps_csv(&records, limit))?;
+            put("cycles.csv".into(), &cycles_csv(&cycles))?;
         }
-        // Fields at the turning points of the history and at its last step.
-        let mut turning: Vec<&(crate::history::StepRecord, crate::contact::ContactState)> =
-            snapshots.kept.iter().collect();
-        if let Some(last) = &snapshots.previous {
-            turning.push(last);
+        for set in &fields {
+            put(format!("fields/{}.csv", set.stem), &fields_csv(&set.points))?;
         }
         for (rec, state) in turning {
-            let points: Vec<SurfacePoint> = field_points(state.centre, state.half_width, 400)
-                .into_iter()
-                .map(|x| model.surface_point(state, x))
-                .collect();
-            staging.write(
-                &format!("fields/step_{:05}.csv", rec.step),
-                &fields_csv(&points),
+            put(
+                format!("fields/step_{:05}.csv", rec.step),
+                &fields_csv(&sample(state)),
             )?;
         }
-        for (name, svg) in plots(&points, &records, model.friction * scenario.normal_load) {
-            staging.write(&format!("plots/{name}.svg"), svg.as_bytes())?;
-        }
-        staging.write(
-            "index.html",
-            index_html(&scenario.name, &records).as_bytes(),
+        let mut sections = Vec::new();
+        let mut section = |title: &str, plots: Vec<(String, String)>| -> Result<(), Error> {
+            let mut names = Vec::new();
+            for (name, svg) in plots {
+                put(format!("plots/{name}.svg"), svg.as_bytes())?;
+                names.push(name);
+            }
+            if !names.is_empty() {
+                sections.push((title.to_string(), names));
+            }
+            Ok(())
+        };
+        section(
+            "End of normal loading",
+            normal_loading_plots(&fields[0].points),
+        )?;
+        section(
+            "Load history",
+            history_plots(&records, limit, failure.is_some()),
+        )?;
+        let instants: Vec<(&str, &[SurfacePoint])> = fields[1..]
+            .iter()
+            .map(|f| (f.label.as_str(), f.points.as_slice()))
+            .collect();
+        section(
+            "Fields at the snapshot instants",
+            family_plots("snapshots", "at the snapshot instants", &instants),
         )?;
         if let Some(e) = &failure {
             let body = serde_json::json!({
                 "error": e.to_string(),
                 "last_accepted_step": records.last(),
             });
-            staging.write(
-                "failure.json",
+            put(
+                "failure.json".into(),
                 &serde_json::to_vec_pretty(&body).expect("serialises"),
             )?;
         }
+        written.sort();
+        staging.write(
+            "index.html",
+            index_html(&scenario.name, &sections, &written).as_bytes(),
+        )?;
         Ok::<(), Error>(())
     })();
     match result {
         Ok(()) => {
             let out_dir = staging.commit()?;
-            match failure {
-                Some(e) => Err(e),
-                None => Ok(RunResult { out_dir, summary }),
-            }
+            Ok((
+                RunResult {
+                    out_dir,
+                    summary,
+                    fields,
+                },
+                failure,
+            ))
         }
         Err(e) => {
             staging.abandon();
@@ -307,52 +550,33 @@ pub fn run_with(
     }
 }
 
-/// Forwards steps to the caller's observer and keeps the states at the turning points (the
-/// last step of each phase) for the field files.
-struct Snapshots<'a> {
-    inner: &'a mut dyn crate::history::Observer,
-    previous: Option<(crate::history::StepRecord, crate::contact::ContactState)>,
-    kept: Vec<(crate::history::StepRecord, crate::contact::ContactState)>,
-}
-
-impl crate::history::Observer for Snapshots<'_> {
-    fn on_step(
-        &mut self,
-        record: &crate::history::StepRecord,
-        state: &crate::contact::ContactState,
-    ) {
-        if let Some((prev, prev_state)) = self.previous.take()
-            && prev.phase != record.phase
-            && prev.phase > 0
-        {
-            self.kept.push((prev, prev_state));
-        }
-        self.previous = Some((record.clone(), state.clone()));
-        self.inner.on_step(record, state);
-    }
-
-    fn on_phase(&mut self, phase: usize, memory: &crate::contact::memory::Memory) {
-        self.inner.on_phase(phase, memory);
-    }
-}
-
-/// The SVG plots of a run: fields at the end of normal loading, and with a history the
-/// hysteresis loop and the stick-zone ends.
-fn plots(
-    points: &[SurfacePoint],
-    records: &[crate::history::StepRecord],
-    limit: f64,
-) -> Vec<(&'static str, String)> {
+/// The plots of the fields at the end of normal loading.
+fn normal_loading_plots(points: &[SurfacePoint]) -> Vec<(String, String)> {
     use crate::plot::{Series, line_plot};
     let field =
         |f: &dyn Fn(&SurfacePoint) -> f64| points.iter().map(|p| (p.x, f(p))).collect::<Vec<_>>();
-    let mut out = vec![
+    let one = |name: &str, title: &str, y: &str, label: &str, f: &dyn Fn(&SurfacePoint) -> f64| {
         (
-            "normal_loading_tractions",
+            name.to_string(),
             line_plot(
-                "End of normal loading: pressure and shear traction",
+                &format!("End of normal loading: {title}"),
                 "x (m)",
-                "Pa",
+                y,
+                &[Series {
+                    label,
+                    points: field(f),
+                    colour: "black",
+                }],
+            ),
+        )
+    };
+    vec![
+        (
+            "normal_loading_tractions".into(),
+            line_plot(
+                "End of normal loading: pressure p and shear traction q",
+                "x (m)",
+                "p, q (Pa)",
                 &[
                     Series {
                         label: "p",
@@ -367,84 +591,134 @@ fn plots(
                 ],
             ),
         ),
-        (
+        one(
             "normal_loading_charge",
-            line_plot(
-                "End of normal loading: surface charge g",
-                "x (m)",
-                "C/m²",
-                &[Series {
-                    label: "g",
-                    points: field(&|p| p.charge),
-                    colour: "navy",
-                }],
-            ),
+            "surface charge g",
+            "g (C/m²)",
+            "g",
+            &|p| p.charge,
         ),
-        (
+        one(
             "normal_loading_sigma_xx",
-            line_plot(
-                "End of normal loading: surface stress σxx0",
-                "x (m)",
-                "Pa",
-                &[Series {
-                    label: "σxx0",
-                    points: field(&|p| p.sigma_xx),
-                    colour: "darkgreen",
-                }],
-            ),
+            "surface stress σxx0",
+            "σxx0 (Pa)",
+            "σxx0",
+            &|p| p.sigma_xx,
         ),
-        (
+        one(
             "normal_loading_d_x",
-            line_plot(
-                "End of normal loading: in-plane electric displacement Dx0",
-                "x (m)",
-                "C/m²",
-                &[Series {
-                    label: "Dx0",
-                    points: field(&|p| p.d_x),
-                    colour: "purple",
-                }],
-            ),
+            "in-plane electric displacement Dx0",
+            "Dx0 (C/m²)",
+            "Dx0",
+            &|p| p.d_x,
+        ),
+    ]
+}
+
+/// One plot per field quantity (p, q, g, σxx0, Dx0) with one curve per member of a family
+/// (snapshot instants of a run, or variants of a sweep), named `<prefix>_<quantity>`. Empty
+/// when the family is empty.
+pub fn family_plots(
+    prefix: &str,
+    what: &str,
+    family: &[(&str, &[SurfacePoint])],
+) -> Vec<(String, String)> {
+    use crate::plot::{PALETTE, Series, line_plot};
+    if family.is_empty() {
+        return Vec::new();
+    }
+    type Quantity = (
+        &'static str,
+        &'static str,
+        &'static str,
+        fn(&SurfacePoint) -> f64,
+    );
+    let quantities: [Quantity; 5] = [
+        ("p", "Pressure p", "p (Pa)", |p| p.pressure),
+        ("q", "Shear traction q (on the half-plane)", "q (Pa)", |p| {
+            p.traction
+        }),
+        ("g", "Surface charge g", "g (C/m²)", |p| p.charge),
+        ("sigma_xx", "Surface stress σxx0", "σxx0 (Pa)", |p| {
+            p.sigma_xx
+        }),
+        (
+            "d_x",
+            "In-plane electric displacement Dx0",
+            "Dx0 (C/m²)",
+            |p| p.d_x,
         ),
     ];
-    if records.len() > 1 {
-        let loop_pts: Vec<(f64, f64)> = records
+    quantities
+        .iter()
+        .map(|(key, title, y, f)| {
+            let series: Vec<Series> = family
+                .iter()
+                .enumerate()
+                .map(|(k, (label, points))| Series {
+                    label,
+                    points: points.iter().map(|p| (p.x, f(p))).collect(),
+                    colour: PALETTE[k % PALETTE.len()],
+                })
+                .collect();
+            (
+                format!("{prefix}_{key}"),
+                line_plot(&format!("{title} {what}"), "x (m)", y, &series),
+            )
+        })
+        .collect()
+}
+
+/// With a history (and at least one step after normal loading): the hysteresis loop and the
+/// stick-zone ends.
+fn history_plots(
+    records: &[crate::history::StepRecord],
+    limit: f64,
+    failed: bool,
+) -> Vec<(String, String)> {
+    use crate::plot::{Series, line_plot};
+    if records.len() <= 1 {
+        return Vec::new();
+    }
+    let note = if failed { " (stopped early)" } else { "" };
+    let loop_pts: Vec<(f64, f64)> = records
+        .iter()
+        .map(|r| (r.displacement, r.q / limit))
+        .collect();
+    let ends = |f: &dyn Fn(&crate::history::StepRecord) -> f64| {
+        records
             .iter()
-            .map(|r| (r.displacement, r.q / limit))
-            .collect();
-        out.push((
-            "hysteresis",
+            .map(|r| (r.t, f(r) / r.half_width))
+            .collect::<Vec<_>>()
+    };
+    vec![
+        (
+            "hysteresis".into(),
             line_plot(
-                "Fretting loop",
+                &format!("Fretting loop{note}"),
                 "tangential displacement δ (m)",
-                "Q/(ηP)",
+                "Q/(ηP) (–)",
                 &[Series {
                     label: "Q–δ",
                     points: loop_pts,
                     colour: "black",
                 }],
             ),
-        ));
-        let ends = |f: &dyn Fn(&crate::history::StepRecord) -> f64| {
-            records
-                .iter()
-                .map(|r| (r.step as f64, f(r) / r.half_width))
-                .collect::<Vec<_>>()
-        };
-        out.push((
-            "stick_zone",
+        ),
+        (
+            "stick_zone".into(),
             line_plot(
-                "Stick-zone ends and contact ends",
-                "step",
-                "x / a",
+                &format!("Stick-zone ends and contact ends{note}"),
+                "time t (s)",
+                "x / a (–)",
                 &[
                     Series {
-                        label: "stick left end",
+                        label: "stick-zone left end",
                         points: ends(&|r| r.stick_lo),
                         colour: "navy",
                     },
                     Series {
-                        label: "stick right end",
+                        label: "stick-zone right end",
                         points: ends(&|r| r.stick_hi),
                         colour: "crimson",
                     },
@@ -460,28 +734,29 @@ fn plots(
                     },
                 ],
             ),
-        ));
-    }
-    out
+        ),
+    ]
 }
 
-/// `index.html`: all plots on one page.
-fn index_html(name: &str, records: &[crate::history::StepRecord]) -> String {
-    let mut names = vec![
-        "normal_loading_tractions",
-        "normal_loading_charge",
-        "normal_loading_sigma_xx",
-        "normal_loading_d_x",
-    ];
-    if records.len() > 1 {
-        names.extend(["hysteresis", "stick_zone"]);
+/// `index.html`: every plot on one page, in sections, and links to every file.
+pub fn index_html(name: &str, sections: &[(String, Vec<String>)], files: &[String]) -> String {
+    use crate::plot::escape;
+    let name = escape(name);
+    let mut body = String::new();
+    for (title, plots) in sections {
+        body.push_str(&format!("<h2>{}</h2>\n", escape(title)));
+        for p in plots {
+            body.push_str(&format!(
+                "<figure><img src=\"plots/{p}.svg\" alt=\"{p}\"><figcaption>plots/{p}.svg</figcaption></figure>\n"
+            ));
+        }
     }
-    let imgs: String = names
+    let links: String = files
         .iter()
-        .map(|n| format!("<figure><img src=\"plots/{n}.svg\" alt=\"{n}\"></figure>\n"))
+        .map(|f| format!("<li><a href=\"{f}\">{f}</a></li>\n", f = escape(f)))
         .collect();
     format!(
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>fretsim: {name}</title></head>\n<body>\n<h1>fretsim: {name}</h1>\n<p>Files: summary.json, fields/normal_loading.csv, steps.csv, cycles.csv (see README).</p>\n{imgs}</body></html>\n"
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>fretsim: {name}</title></head>\n<body>\n<h1>fretsim: {name}</h1>\n<p>Columns and units of every file: see the fretsim README.</p>\n{body}<h2>Files</h2>\n<ul>\n{links}</ul>\n</body></html>\n"
     )
 }
 
@@ -506,46 +781,53 @@ fn fields_csv(points: &[SurfacePoint]) -> Vec<u8> {
 
 /// `cycles.csv`: one row per fretting cycle.
 fn cycles_csv(cycles: &[CycleRow]) -> Vec<u8> {
-    let rows: Vec<Vec<f64>> = cycles
-        .iter()
-        .map(|c| {
-            vec![
-                c.cycle as f64,
-                c.steps.0 as f64,
-                c.steps.1 as f64,
-                c.loop_area,
-                c.friction_work,
-                c.normal_work,
-                c.electric_work,
-                c.displacement_extremes.0,
-                c.displacement_extremes.1,
-                c.stick_at_max.0,
-                c.stick_at_max.1,
-                c.stick_at_min.0,
-                c.stick_at_min.1,
-                c.change.unwrap_or(f64::NAN),
-            ]
-        })
-        .collect();
-    csv_bytes(
-        &[
-            "cycle",
-            "first_step",
-            "last_step",
-            "loop_area_J_per_m",
-            "friction_work_J_per_m",
-            "normal_work_J_per_m",
-            "electric_work_J_per_m",
-            "delta_at_max_m",
-            "delta_at_min_m",
-            "stick_lo_at_max_m",
-            "stick_hi_at_max_m",
-            "stick_lo_at_min_m",
-            "stick_hi_at_min_m",
-            "change_vs_previous",
-        ],
-        &rows,
-    )
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record([
+        "cycle",
+        "first_step",
+        "last_step",
+        "Q_start_N_per_m",
+        "Q_min_N_per_m",
+        "Q_end_N_per_m",
+        "loop_area_J_per_m",
+        "friction_work_J_per_m",
+        "normal_work_J_per_m",
+        "electric_work_J_per_m",
+        "delta_at_max_m",
+        "delta_at_min_m",
+        "stick_lo_at_max_m",
+        "stick_hi_at_max_m",
+        "stick_lo_at_min_m",
+        "stick_hi_at_min_m",
+        "change_vs_previous",
+        "compared_with_cycle",
+    ])
+    .expect("in-memory write");
+    let f = |x: f64| format!("{x:.10e}");
+    for c in cycles {
+        w.write_record([
+            c.cycle.to_string(),
+            c.steps.0.to_string(),
+            c.steps.1.to_string(),
+            f(c.loads.0),
+            f(c.loads.1),
+            f(c.loads.2),
+            f(c.loop_area),
+            f(c.friction_work),
+            f(c.normal_work),
+            f(c.electric_work),
+            f(c.displacement_extremes.0),
+            f(c.displacement_extremes.1),
+            f(c.stick_at_max.0),
+            f(c.stick_at_max.1),
+            f(c.stick_at_min.0),
+            f(c.stick_at_min.1),
+            c.change.map(f).unwrap_or_default(),
+            c.compared_with.map(|k| k.to_string()).unwrap_or_default(),
+        ])
+        .expect("in-memory write");
+    }
+    w.into_inner().expect("in-memory write")
 }
 
 /// `steps.csv`: one row per accepted step.
@@ -698,14 +980,57 @@ fn set_path(value: &mut serde_json::Value, path: &str, x: f64) -> Result<(), Str
     Ok(())
 }
 
-/// Run the normal-loading solve for every variant of `text` (a scenario) over the Cartesian
-/// product of `vary`, in parallel, and return the CSV bytes of one row per variant.
-pub fn sweep(
+/// Options of a sweep.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SweepOptions {
+    /// Run only one shard of the variants.
+    pub shard: Option<Shard>,
+    /// Run each variant's whole scenario (history included) into `variant_NNNN/` instead of
+    /// the normal-loading solve alone.
+    pub runs: bool,
+}
+
+/// What a sweep wrote.
+#[derive(Debug)]
+pub struct SweepOutput {
+    /// The CSV file (`sweep.csv` or `sweep-I-of-N.csv`).
+    pub csv: PathBuf,
+    /// Variants run.
+    pub variants: usize,
+    /// Variants whose solve failed (their `error` column is filled).
+    pub failed: usize,
+}
+
+/// The folder of variant `index` of a sweep run with [`SweepOptions::runs`].
+pub fn variant_dir(index: usize) -> String {
+    format!("variant_{index:04}")
+}
+
+/// A legend label for a variant: `friction = 0.3, punch.electrode.charge = 6e-7`.
+fn variant_label(vary: &[Vary], values: &[f64]) -> String {
+    vary.iter()
+        .zip(values)
+        .map(|(v, x)| {
+            // Six significant digits, without the noise of the linear spacing.
+            let x: f64 = format!("{x:.5e}").parse().unwrap_or(*x);
+            if x == 0.0 || (1e-3..1e4).contains(&x.abs()) {
+                format!("{} = {x}", v.path)
+            } else {
+                format!("{} = {x:e}", v.path)
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The scenario variants of a sweep: every point of the Cartesian product of `vary` (in the
+/// shard), validated before any is solved.
+fn sweep_variants(
     text: &str,
     source: &Path,
     vary: &[Vary],
     shard: Option<Shard>,
-) -> Result<Vec<u8>, Error> {
+) -> Result<Vec<(usize, Vec<f64>, Scenario)>, Error> {
     let base: serde_json::Value = serde_json::from_str(text).map_err(|e| Error::ParseScenario {
         path: source.to_path_buf(),
         at: String::new(),
@@ -726,7 +1051,6 @@ pub fn sweep(
         .enumerate()
         .filter(|(i, _)| shard.is_none_or(|s| i % s.count == s.index - 1))
         .collect();
-    // Validate every variant before solving any.
     let mut scenarios = Vec::new();
     let mut issues = Vec::new();
     for (i, values) in &selected {
@@ -752,39 +1076,82 @@ pub fn sweep(
             issues,
         });
     }
+    Ok(scenarios)
+}
+
+/// One solved (or failed) variant.
+struct VariantOutcome {
+    normal: Option<NormalSummary>,
+    error: Option<Error>,
+    fields: Vec<FieldSet>,
+}
+
+/// Run every variant of `text` (a scenario) over the Cartesian product of `vary`, in
+/// parallel, and write one CSV row per variant into `out_dir`. By default each variant is the
+/// normal-loading solve alone; with [`SweepOptions::runs`] each variant's whole scenario is
+/// run into `out_dir/variant_NNNN/` (all the files of `fretsim run`), and without a shard the
+/// fields of all variants are compared in `out_dir/plots/compare_*.svg` and `index.html`.
+/// `on_variant` is called as each variant finishes (progress bars).
+pub fn sweep(
+    text: &str,
+    source: &Path,
+    vary: &[Vary],
+    options: SweepOptions,
+    out_dir: &Path,
+    on_variant: &(dyn Fn() + Sync),
+) -> Result<SweepOutput, Error> {
+    let scenarios = sweep_variants(text, source, vary, options.shard)?;
     use rayon::prelude::*;
-    let rows: Vec<Vec<String>> = scenarios
+    let mut outcomes: Vec<VariantOutcome> = scenarios
         .par_iter()
-        .map(|(i, values, sc)| {
-            let disc = Discretisation::new(sc.collocation_points);
-            let mut row = vec![i.to_string()];
-            row.extend(values.iter().map(|x| format!("{x:.12e}")));
-            match solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()) {
-                Ok(n) => {
-                    let s = &n.state;
-                    row.extend(
-                        [
-                            s.half_width,
-                            n.stick_half_width / s.half_width,
-                            n.strain_slope,
-                            s.pressure_at(s.centre),
-                            s.charge,
-                            s.potential.unwrap_or(f64::NAN),
-                            s.traction.right_sign,
-                        ]
-                        .iter()
-                        .map(|x| format!("{x:.10e}")),
-                    );
-                    row.push(String::new());
+        .map(|(i, _, sc)| {
+            let outcome = if options.runs {
+                let dir = out_dir.join(variant_dir(*i));
+                match run_partial(sc, &dir, &mut crate::history::NoObserver) {
+                    // A history that stops part-way keeps its normal loading and the fields
+                    // reached.
+                    Ok((r, error)) => VariantOutcome {
+                        normal: Some(r.summary.normal_loading),
+                        error,
+                        fields: r.fields,
+                    },
+                    Err(e) => VariantOutcome {
+                        normal: None,
+                        error: Some(e),
+                        fields: Vec::new(),
+                    },
                 }
-                Err(e) => {
-                    row.extend(std::iter::repeat_n("NaN".to_string(), 7));
-                    row.push(e.to_string());
+            } else {
+                let disc = Discretisation::new(sc.collocation_points);
+                match solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()) {
+                    Ok(n) => VariantOutcome {
+                        normal: Some(normal_summary(&sc.model, &n)),
+                        error: None,
+                        fields: Vec::new(),
+                    },
+                    Err(failure) => VariantOutcome {
+                        normal: None,
+                        error: Some(Error::Solve {
+                            context: "normal loading".into(),
+                            failure,
+                        }),
+                        fields: Vec::new(),
+                    },
                 }
-            }
-            row
+            };
+            on_variant();
+            outcome
         })
         .collect();
+    // An output folder that cannot be written stops the sweep (exit 2); solver failures are
+    // reported per variant.
+    if let Some(k) = outcomes
+        .iter()
+        .position(|o| matches!(o.error, Some(Error::WriteOutput { .. })))
+        && let Some(e) = outcomes.swap_remove(k).error
+    {
+        return Err(e);
+    }
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header = vec!["variant".to_string()];
     header.extend(vary.iter().map(|v| v.path.clone()));
@@ -802,10 +1169,113 @@ pub fn sweep(
         .map(String::from),
     );
     w.write_record(&header).expect("in-memory write");
-    for r in rows {
-        w.write_record(&r).expect("in-memory write");
+    for ((i, values, _), o) in scenarios.iter().zip(&outcomes) {
+        let mut row = vec![i.to_string()];
+        row.extend(values.iter().map(|x| format!("{x:.12e}")));
+        match &o.normal {
+            Some(n) => row.extend(
+                [
+                    n.half_width,
+                    n.stick_ratio,
+                    n.strain_slope,
+                    n.peak_pressure,
+                    n.charge,
+                    n.potential.unwrap_or(f64::NAN),
+                    n.right_slip_sign,
+                ]
+                .iter()
+                .map(|x| format!("{x:.10e}")),
+            ),
+            None => row.extend(std::iter::repeat_n("NaN".to_string(), 7)),
+        }
+        row.push(o.error.as_ref().map(|e| e.to_string()).unwrap_or_default());
+        w.write_record(&row).expect("in-memory write");
     }
-    Ok(w.into_inner().expect("in-memory write"))
+    let name = match options.shard {
+        Some(s) => format!("sweep-{}-of-{}.csv", s.index, s.count),
+        None => "sweep.csv".to_string(),
+    };
+    let csv_path = out_dir.join(&name);
+    crate::output::write_atomic(&csv_path, &w.into_inner().expect("in-memory write"))?;
+    if options.runs && options.shard.is_none() {
+        write_comparison(vary, &scenarios, &outcomes, out_dir, &name)?;
+    }
+    Ok(SweepOutput {
+        csv: csv_path,
+        variants: outcomes.len(),
+        failed: outcomes.iter().filter(|o| o.error.is_some()).count(),
+    })
+}
+
+/// The comparison plots of a sweep with runs: for the end of normal loading and each snapshot
+/// instant, p, q, g, σxx0 and Dx0 with one curve per variant; and the sweep's `index.html`.
+fn write_comparison(
+    vary: &[Vary],
+    scenarios: &[(usize, Vec<f64>, Scenario)],
+    outcomes: &[VariantOutcome],
+    out_dir: &Path,
+    csv_name: &str,
+) -> Result<(), Error> {
+    let labels: Vec<String> = scenarios
+        .iter()
+        .map(|(_, values, _)| variant_label(vary, values))
+        .collect();
+    let mut stems = vec!["normal_loading".to_string()];
+    if let Some((_, _, sc)) = scenarios.first() {
+        stems.extend(
+            sc.snapshots
+                .iter()
+                .map(|t| crate::scenario::snapshot_stem(*t)),
+        );
+    }
+    let mut sections = Vec::new();
+    for stem in &stems {
+        let family: Vec<(&str, &[SurfacePoint])> = labels
+            .iter()
+            .zip(outcomes)
+            .filter_map(|(label, o)| {
+                let set = o.fields.iter().find(|f| &f.stem == stem)?;
+                Some((label.as_str(), set.points.as_slice()))
+            })
+            .collect();
+        let what = match scenarios.first() {
+            Some((_, _, sc)) if stem != "normal_loading" => {
+                let t = sc
+                    .snapshots
+                    .iter()
+                    .find(|t| &crate::scenario::snapshot_stem(**t) == stem)
+                    .copied()
+                    .unwrap_or(f64::NAN);
+                format!("at t = {t} s")
+            }
+            _ => "at the end of normal loading".to_string(),
+        };
+        let plots = family_plots(&format!("compare_{stem}"), &what, &family);
+        let mut names = Vec::new();
+        for (name, svg) in plots {
+            crate::output::write_atomic(
+                &out_dir.join("plots").join(format!("{name}.svg")),
+                svg.as_bytes(),
+            )?;
+            names.push(name);
+        }
+        if !names.is_empty() {
+            sections.push((format!("Fields {what}, by variant"), names));
+        }
+    }
+    let mut files = vec![csv_name.to_string()];
+    files.extend(
+        scenarios
+            .iter()
+            .map(|(i, _, _)| format!("{}/index.html", variant_dir(*i))),
+    );
+    let name = scenarios
+        .first()
+        .map_or("sweep", |(_, _, sc)| sc.name.as_str());
+    crate::output::write_atomic(
+        &out_dir.join("index.html"),
+        index_html(&format!("{name} (sweep)"), &sections, &files).as_bytes(),
+    )
 }
 
 /// One fretting cycle: from a positive extreme of Q to the next.
@@ -815,6 +1285,8 @@ pub struct CycleRow {
     pub cycle: usize,
     /// First and last step.
     pub steps: (usize, usize),
+    /// Q at the start, the minimum and the end of the cycle (N/m).
+    pub loads: (f64, f64, f64),
     /// Loop area ∮Q dδ (J/m), trapezoidal over the steps.
     pub loop_area: f64,
     /// Frictional work Σ −∫ q Δs (J/m).
@@ -829,9 +1301,12 @@ pub struct CycleRow {
     pub stick_at_max: (f64, f64),
     /// Stick-zone ends at the negative extreme (m).
     pub stick_at_min: (f64, f64),
-    /// Largest change against the previous cycle, relative (stick ends to a, δ to the δ
-    /// amplitude, energy to the loop area); `None` for the first cycle.
+    /// Largest change against the latest earlier cycle under the same loads (start, minimum
+    /// and end of Q), relative (stick ends to a, δ to the δ amplitude, energy to the loop
+    /// area); `None` when no earlier cycle had the same loads.
     pub change: Option<f64>,
+    /// The cycle compared with.
+    pub compared_with: Option<usize>,
 }
 
 /// Whether the cycles have settled.
@@ -840,7 +1315,8 @@ pub struct CycleRow {
 pub enum Verdict {
     /// The response repeats within the tolerance from this cycle on.
     SteadyCyclicSlip {
-        /// First cycle of the repeating sequence (every later cycle repeats it).
+        /// Every cycle after this one repeats the latest earlier cycle under the same loads
+        /// (start, minimum and end of Q) within the tolerance.
         from_cycle: usize,
     },
     /// Slip has stopped: the dissipation per cycle vanishes.
@@ -877,6 +1353,7 @@ pub fn analyse_cycles(
         )
         .collect();
     let mut rows: Vec<CycleRow> = Vec::new();
+    let load_scale = records.iter().map(|r| r.q.abs()).fold(0.0, f64::max);
     for (k, w) in maxima.windows(2).enumerate() {
         let seg = &records[w[0]..=w[1]];
         let area = seg
@@ -894,6 +1371,7 @@ pub fn analyse_cycles(
         let mut row = CycleRow {
             cycle: k + 1,
             steps: (seg[0].step, hi_rec.step),
+            loads: (seg[0].q, lo_rec.q, hi_rec.q),
             loop_area: area,
             friction_work: work,
             normal_work,
@@ -902,8 +1380,16 @@ pub fn analyse_cycles(
             stick_at_max: (hi_rec.stick_lo, hi_rec.stick_hi),
             stick_at_min: (lo_rec.stick_lo, lo_rec.stick_hi),
             change: None,
+            compared_with: None,
         };
-        if let Some(prev) = rows.last() {
+        // Compare with the latest earlier cycle under the same loads (start, minimum, end):
+        // the previous cycle under constant amplitude, the same cycle one block earlier under
+        // a repeated variable-amplitude block.
+        let same = |a: (f64, f64, f64), b: (f64, f64, f64)| {
+            let tol = 1e-9 * load_scale;
+            (a.0 - b.0).abs() <= tol && (a.1 - b.1).abs() <= tol && (a.2 - b.2).abs() <= tol
+        };
+        if let Some(prev) = rows.iter().rev().find(|r| same(r.loads, row.loads)) {
             let a = hi_rec.half_width;
             let amp = (prev.displacement_extremes.0 - prev.displacement_extremes.1)
                 .abs()
@@ -919,6 +1405,7 @@ pub fn analyse_cycles(
                 (row.loop_area - prev.loop_area).abs() / energy,
             ];
             row.change = Some(d.into_iter().fold(0.0, f64::max));
+            row.compared_with = Some(prev.cycle);
         }
         rows.push(row);
     }
@@ -926,21 +1413,17 @@ pub fn analyse_cycles(
         Verdict::NoCycles
     } else if let Some(r) = rows.iter().find(|r| {
         let amp = (r.displacement_extremes.0 - r.displacement_extremes.1).abs();
-        let load = records.iter().map(|x| x.q.abs()).fold(0.0, f64::max);
-        r.loop_area.abs() <= tolerance * amp * load
+        r.loop_area.abs() <= tolerance * amp * load_scale
     }) {
         Verdict::Shakedown {
             from_cycle: r.cycle,
         }
     } else {
-        // Steady from cycle k when every later cycle repeats its predecessor.
-        // `from_cycle` is the first cycle of the repeating sequence.
+        // Steady from cycle k when every later cycle repeats the latest earlier cycle under
+        // the same loads (and at least one does).
+        let repeats = |r: &CycleRow| r.change.is_some_and(|c| c <= tolerance);
         let first_steady = (1..rows.len())
-            .find(|&i| {
-                rows[i..]
-                    .iter()
-                    .all(|r| r.change.is_some_and(|c| c <= tolerance))
-            })
+            .find(|&i| rows[i..].iter().all(repeats))
             .map(|i| rows[i - 1].cycle);
         match first_steady {
             Some(from_cycle) => Verdict::SteadyCyclicSlip { from_cycle },

@@ -27,8 +27,10 @@ pub enum Command {
         #[arg(long)]
         quiet: bool,
     },
-    /// Normal-loading sweep over scenario fields (e.g. b/a and C against η, the seed paper's
-    /// Figures 8–9): one CSV row per variant, variants solved in parallel.
+    /// Sweep over scenario fields: one CSV row per variant, variants solved in parallel. By
+    /// default each variant is the normal-loading solve alone (e.g. b/a and C against η, the
+    /// seed paper's Figures 8–9); with `--runs` each variant's whole scenario is run into
+    /// `variant_NNNN/` and the fields of all variants are plotted together (Figures 6–7, 10–19).
     Sweep {
         /// Scenario file (JSON).
         scenario: PathBuf,
@@ -41,6 +43,14 @@ pub enum Command {
         /// Run only every N-th variant starting at I (`I/N`), for array jobs.
         #[arg(long)]
         shard: Option<crate::app::Shard>,
+        /// Run each variant's whole scenario (history, snapshots, plots) into
+        /// `OUT/variant_NNNN/`, and write comparison plots `OUT/plots/compare_*.svg` (not with
+        /// `--shard`).
+        #[arg(long)]
+        runs: bool,
+        /// No progress output.
+        #[arg(long)]
+        quiet: bool,
     },
     /// Validate a scenario file without solving.
     Check {

@@ -31,7 +31,7 @@ impl Progress {
         }
         let bar = indicatif::ProgressBar::new(total);
         bar.set_style(
-            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps {msg}")
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}")
                 .expect("valid template"),
         );
         Self(Some(bar))
@@ -52,7 +52,7 @@ impl fretsim::history::Observer for Progress {
     ) {
         if let (Some(b), true) = (&self.0, record.step > 0) {
             b.set_position(record.step as u64);
-            b.set_message(format!("Q = {:.1} N/m", record.q));
+            b.set_message(format!("steps, Q = {:.1} N/m", record.q));
         }
     }
 }
@@ -96,21 +96,45 @@ fn dispatch(command: Command) -> Result<(), Error> {
             vary,
             out,
             shard,
+            runs,
+            quiet,
         } => {
             let sc = scenario::load(&path)?;
             let text = std::fs::read_to_string(&path).map_err(|source| Error::ReadScenario {
                 path: path.clone(),
                 source,
             })?;
-            let bytes = app::sweep(&text, &path, &vary, shard)?;
             let out =
                 out.unwrap_or_else(|| PathBuf::from("output").join(format!("{}-sweep", sc.name)));
-            let name = match shard {
-                Some(s) => format!("sweep-{}-of-{}.csv", s.index, s.count),
-                None => "sweep.csv".to_string(),
+            let total = vary.iter().map(|v| v.values.len()).product::<usize>();
+            let variants = (0..total)
+                .filter(|i| shard.is_none_or(|s| i % s.count == s.index - 1))
+                .count();
+            let progress = Progress::new(variants as u64, quiet);
+            let bar = progress.0.clone();
+            if let Some(b) = &bar {
+                b.set_message("variants");
+            }
+            let done = std::sync::atomic::AtomicU64::new(0);
+            let on_variant = move || {
+                let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                if let Some(b) = &bar {
+                    b.set_position(n);
+                }
             };
-            fretsim::output::write_atomic(&out.join(&name), &bytes)?;
-            println!("{} -> {}", path.display(), out.join(name).display());
+            let options = app::SweepOptions { shard, runs };
+            let result = app::sweep(&text, &path, &vary, options, &out, &on_variant);
+            progress.finish();
+            let result = result?;
+            if !quiet {
+                println!(
+                    "{}: {} variant(s), {} failed -> {}",
+                    path.display(),
+                    result.variants,
+                    result.failed,
+                    result.csv.display()
+                );
+            }
             Ok(())
         }
         Command::Check { scenario: path } => {

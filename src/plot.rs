@@ -29,9 +29,41 @@ fn nice_ticks(lo: f64, hi: f64) -> Vec<f64> {
         .collect()
 }
 
-/// A line plot as an SVG document.
+/// Colours for families of curves (one per snapshot instant or sweep variant); beyond ten,
+/// [`line_plot`] dashes the repeated colours.
+pub const PALETTE: [&str; 10] = [
+    "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2",
+    "#7f7f7f", "#bcbd22",
+];
+
+/// Escape text for SVG/HTML.
+pub fn escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A tick label: the shortest form that shows the tick spacing `step` (fixed notation for
+/// 1e−3 ≤ |v| < 1e4, scientific otherwise; `0` for zero).
+fn tick_label(v: f64, step: f64) -> String {
+    if v.abs() < 1e-9 * step {
+        return "0".into();
+    }
+    let step_exp = step.log10().floor() as i32;
+    if (1e-3..1e4).contains(&v.abs()) {
+        format!("{v:.*}", (-step_exp).max(0) as usize)
+    } else {
+        let exp = v.abs().log10().floor() as i32;
+        format!("{v:.*e}", (exp - step_exp).max(0) as usize)
+    }
+}
+
+/// A line plot as an SVG document: axes with ticks, labels (units in the labels), and a legend
+/// to the right of the plot area (series with an empty label are not listed).
 pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series<'_>]) -> String {
-    let (w, h, left, right, top, bottom) = (720.0, 440.0, 90.0, 20.0, 40.0, 60.0);
+    let (w, h, left, right, top, bottom) = (960.0, 440.0, 90.0, 250.0, 40.0, 60.0);
+    let (title, x_label, y_label) = (escape(title), escape(x_label), escape(y_label));
     let pts = series
         .iter()
         .flat_map(|s| s.points.iter())
@@ -70,9 +102,15 @@ pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series<'_>
     let _ = write!(
         svg,
         r#"<text x="{}" y="22" text-anchor="middle" font-size="14">{title}</text>"#,
-        w / 2.0
+        (left + w - right) / 2.0
     );
-    for t in nice_ticks(x0, x1) {
+    let step_of = |ticks: &[f64]| match ticks {
+        [a, b, ..] => b - a,
+        _ => 1.0,
+    };
+    let x_ticks = nice_ticks(x0, x1);
+    let x_step = step_of(&x_ticks);
+    for t in x_ticks {
         let x = sx(t);
         let _ = write!(
             svg,
@@ -81,11 +119,14 @@ pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series<'_>
         );
         let _ = write!(
             svg,
-            r#"<text x="{x:.1}" y="{:.1}" text-anchor="middle">{t:.3e}</text>"#,
-            h - bottom + 16.0
+            r#"<text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"#,
+            h - bottom + 16.0,
+            tick_label(t, x_step)
         );
     }
-    for t in nice_ticks(y0, y1) {
+    let y_ticks = nice_ticks(y0, y1);
+    let y_step = step_of(&y_ticks);
+    for t in y_ticks {
         let y = sy(t);
         let _ = write!(
             svg,
@@ -94,9 +135,10 @@ pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series<'_>
         );
         let _ = write!(
             svg,
-            r#"<text x="{:.1}" y="{:.1}" text-anchor="end">{t:.3e}</text>"#,
+            r#"<text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"#,
             left - 6.0,
-            y + 4.0
+            y + 4.0,
+            tick_label(t, y_step)
         );
     }
     let _ = write!(
@@ -117,6 +159,7 @@ pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series<'_>
         top + (h - top - bottom) / 2.0,
         top + (h - top - bottom) / 2.0
     );
+    let mut legend_row = 0;
     for (k, s) in series.iter().enumerate() {
         let path: Vec<String> = s
             .points
@@ -124,22 +167,32 @@ pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series<'_>
             .filter(|(x, y)| x.is_finite() && y.is_finite())
             .map(|(x, y)| format!("{:.2},{:.2}", sx(*x), sy(*y)))
             .collect();
+        // Colours repeat after the palette: dash the repeats so that curves stay distinct.
+        let dash = match k / PALETTE.len() {
+            0 => "",
+            1 => r#" stroke-dasharray="6 3""#,
+            _ => r#" stroke-dasharray="2 2""#,
+        };
         let _ = write!(
             svg,
-            r#"<polyline fill="none" stroke="{}" stroke-width="1.5" points="{}"/>"#,
+            r#"<polyline fill="none" stroke="{}" stroke-width="1.5"{dash} points="{}"/>"#,
             s.colour,
             path.join(" ")
         );
-        let ly = top + 16.0 + 16.0 * k as f64;
+        if s.label.is_empty() {
+            continue;
+        }
+        let ly = top + 8.0 + 18.0 * legend_row as f64;
+        legend_row += 1;
+        let lx = w - right + 12.0;
         let _ = write!(
             svg,
-            r#"<line x1="{:.1}" y1="{ly:.1}" x2="{:.1}" y2="{ly:.1}" stroke="{}" stroke-width="2"/><text x="{:.1}" y="{:.1}">{}</text>"#,
-            left + 10.0,
-            left + 30.0,
+            r#"<line x1="{lx:.1}" y1="{ly:.1}" x2="{:.1}" y2="{ly:.1}" stroke="{}" stroke-width="2"{dash}/><text x="{:.1}" y="{:.1}">{}</text>"#,
+            lx + 24.0,
             s.colour,
-            left + 36.0,
+            lx + 30.0,
             ly + 4.0,
-            s.label
+            escape(s.label)
         );
     }
     svg.push_str("</svg>\n");
@@ -166,5 +219,39 @@ mod tests {
             colour: "black",
         };
         assert_eq!(a, line_plot("t", "x", "y", &[s2]));
+    }
+
+    #[test]
+    fn tick_labels_show_the_spacing_and_no_more() {
+        assert_eq!(tick_label(0.4, 0.2), "0.4");
+        assert_eq!(tick_label(2.0, 0.5), "2.0");
+        assert_eq!(tick_label(5e-5, 1e-5), "5e-5");
+        assert_eq!(tick_label(-2.5e-5, 5e-6), "-2.5e-5");
+        assert_eq!(tick_label(1.2e7, 2e6), "1.2e7");
+        assert_eq!(tick_label(1e-22, 0.5), "0");
+        assert_eq!(tick_label(250.0, 50.0), "250");
+    }
+
+    #[test]
+    fn text_is_escaped_and_unlabelled_series_have_no_legend_entry() {
+        let s = [
+            Series {
+                label: "p < q & r",
+                points: vec![(0.0, 0.0), (1.0, 1.0)],
+                colour: "black",
+            },
+            Series {
+                label: "",
+                points: vec![(0.0, 1.0), (1.0, 0.0)],
+                colour: "gray",
+            },
+        ];
+        let svg = line_plot("a & b", "x (m)", "p (Pa)", &s);
+        assert!(svg.contains("p &lt; q &amp; r") && svg.contains("a &amp; b"));
+        assert_eq!(svg.matches("<polyline").count(), 2);
+        assert_eq!(
+            svg.matches("<line x1=").count() - svg.matches("stroke=\"#ddd\"").count(),
+            1
+        );
     }
 }

@@ -38,6 +38,44 @@ pub struct RawScenario {
     /// Tangential load history after normal loading (optional).
     #[serde(default)]
     pub tangential_history: Option<RawHistory>,
+    /// Output options.
+    #[serde(default)]
+    pub output: RawOutput,
+}
+
+/// Output options.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawOutput {
+    /// Times t (s, in the history's time axis) at which the fields are written to
+    /// `fields/t_<t>.csv` and plotted; strictly increasing, within the history's span.
+    #[serde(default)]
+    pub snapshots: Vec<f64>,
+    /// Also write `fields/step_NNNNN.csv` at every turning point and at the last step
+    /// (default true).
+    #[serde(default = "default_true")]
+    pub turning_point_fields: bool,
+    /// Sample points per field file (a multiple of 4 in [16, 100000], default 400).
+    #[serde(default = "default_field_points")]
+    pub field_points: usize,
+}
+
+impl Default for RawOutput {
+    fn default() -> Self {
+        Self {
+            snapshots: Vec::new(),
+            turning_point_fields: true,
+            field_points: default_field_points(),
+        }
+    }
+}
+
+fn default_true() -> bool {
+    true
+}
+
+fn default_field_points() -> usize {
+    400
 }
 
 /// Unit of the tangential loads in a history.
@@ -187,8 +225,13 @@ pub struct Scenario {
     pub normal_load: f64,
     /// M.
     pub collocation_points: usize,
-    /// The tangential load history in N/m, if any.
+    /// The tangential load history in N/m, if any, with a point added at every snapshot time
+    /// that is not already a step time (Q(t) unchanged).
     pub history: Option<crate::history::LoadHistory>,
+    /// Snapshot times (s), as given in `output.snapshots`.
+    pub snapshots: Vec<f64>,
+    /// Two times closer than this (s) are the same instant (matching snapshots to steps).
+    pub time_tolerance: f64,
     /// The input as read, echoed in the outputs.
     pub raw: RawScenario,
 }
@@ -432,22 +475,136 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
         }
         history
     });
+    let time_tolerance = validate_output(&mut issues, &raw.output, history.as_ref());
     match (material, electrode, issues.is_empty()) {
         (Some(material), Some(electrode), true) => {
             let model = ContactModel::new(material, raw.punch.radius, raw.friction, electrode)
                 .with_reference_distance(raw.reference_distance)
                 .with_coupling(raw.coupling);
+            // Splitting a segment moves its steps, so repeat until every snapshot time is a
+            // step time (each time is added at most once).
+            let history = history.map(|mut h| {
+                while raw
+                    .output
+                    .snapshots
+                    .iter()
+                    .any(|&t| insert_snapshot_point(&mut h, t, time_tolerance))
+                {}
+                h
+            });
             Ok(Scenario {
                 name: raw.name.clone(),
                 model,
                 normal_load: raw.normal_load,
                 collocation_points: m,
                 history,
+                snapshots: raw.output.snapshots.clone(),
+                time_tolerance,
                 raw,
             })
         }
         _ => Err(issues),
     }
+}
+
+/// The file stem of the field snapshot at time `t` (s): `t_<t with 6 decimals>`.
+pub fn snapshot_stem(t: f64) -> String {
+    // `+ 0.0` turns −0 into +0, so that t = −0 and t = 0 share a name.
+    format!("t_{:.6}", t + 0.0)
+}
+
+/// Check the output options; returns the time tolerance used to match snapshot times to steps
+/// (1e−9 of the history's largest time scale).
+fn validate_output(
+    issues: &mut Vec<Issue>,
+    out: &RawOutput,
+    history: Option<&crate::history::LoadHistory>,
+) -> f64 {
+    let n = out.field_points;
+    if !(16..=100_000).contains(&n) || !n.is_multiple_of(4) {
+        issues.push(Issue::new(
+            "output.field_points",
+            format!(
+                "{n} is invalid; it must be a multiple of 4 in [16, 100000] (so that no sample falls on a contact end)"
+            ),
+        ));
+    }
+    let span = history.and_then(|h| Some((h.points.first()?.0, h.points.last()?.0)));
+    let Some((t0, t1)) = span.filter(|(a, b)| a.is_finite() && b.is_finite()) else {
+        if history.is_none() && !out.snapshots.is_empty() {
+            issues.push(Issue::new(
+                "output.snapshots",
+                "a list of times is invalid without a `tangential_history`; it must be [] or omitted \
+                 (the fields at the end of normal loading are always written to fields/normal_loading.csv)",
+            ));
+        }
+        return 0.0;
+    };
+    let tol = 1e-9 * t0.abs().max(t1.abs()).max(t1 - t0);
+    for (i, &t) in out.snapshots.iter().enumerate() {
+        let path = format!("output.snapshots[{i}]");
+        if !t.is_finite() {
+            issues.push(Issue::new(
+                path,
+                format!("{t} s is invalid; it must be finite"),
+            ));
+            continue;
+        }
+        if t < t0 - tol || t > t1 + tol {
+            issues.push(Issue::new(
+                path.clone(),
+                format!("{t} s is invalid; it must lie within the history's span [{t0}, {t1}] s"),
+            ));
+        }
+        if i > 0 {
+            let prev = out.snapshots[i - 1];
+            if prev.is_finite() && t <= prev {
+                issues.push(Issue::new(
+                    path,
+                    format!("{t} s is invalid; it must be > previous t = {prev} s"),
+                ));
+            } else if snapshot_stem(t) == snapshot_stem(prev) {
+                issues.push(Issue::new(
+                    path,
+                    format!(
+                        "{t} s is invalid; it must differ from the previous t = {prev} s in the first 6 decimals \
+                         (both would be written to fields/{}.csv)",
+                        snapshot_stem(t)
+                    ),
+                ));
+            }
+        }
+    }
+    tol
+}
+
+/// Make `t` a step time of `history`: if no step (nor the end of normal loading, nor the first
+/// point) falls within `tol` of it, add the point `(t, Q(t))` of the piecewise-linear history.
+/// Q(t) is unchanged; the segment that held `t` is split in two, each cut into steps by the
+/// usual rule. Returns whether a point was added.
+fn insert_snapshot_point(history: &mut crate::history::LoadHistory, t: f64, tol: f64) -> bool {
+    let Some(&(t0, _)) = history.points.first() else {
+        return false;
+    };
+    let on_grid = (t - t0).abs() <= tol
+        || history
+            .steps()
+            .iter()
+            .any(|&(_, ts, _)| (ts - t).abs() <= tol);
+    if on_grid {
+        return false;
+    }
+    let Some(k) = history
+        .points
+        .windows(2)
+        .position(|w| w[0].0 < t && t < w[1].0)
+    else {
+        return false;
+    };
+    let ((ta, qa), (tb, qb)) = (history.points[k], history.points[k + 1]);
+    let q = qa + (t - ta) / (tb - ta) * (qb - qa);
+    history.points.insert(k + 1, (t, q));
+    true
 }
 
 #[cfg(test)]
@@ -590,6 +747,68 @@ mod history_tests {
                 .iter()
                 .any(|i| i.path == "tangential_history.cycle[1].t")
         );
+    }
+
+    fn with_output(output: &str) -> String {
+        DEFAULT_SCENARIO.replacen(
+            "\"friction\": 0.3,",
+            &format!("\"friction\": 0.3, \"output\": {output},"),
+            1,
+        )
+    }
+
+    #[test]
+    fn output_rules_name_the_field() {
+        // The default history spans [0, 13] s.
+        let found = issues_of(&with_output(
+            r#"{"snapshots": [1.0, 0.5, 14.0, 14.0000001], "field_points": 402}"#,
+        ));
+        let paths: Vec<_> = found.iter().map(|i| i.path.as_str()).collect();
+        assert_eq!(
+            paths,
+            [
+                "output.field_points",
+                "output.snapshots[1]",
+                "output.snapshots[2]",
+                "output.snapshots[3]",
+                "output.snapshots[3]",
+            ]
+        );
+        assert_eq!(
+            found[0].to_string(),
+            "`output.field_points` = 402 is invalid; it must be a multiple of 4 in [16, 100000] (so that no sample falls on a contact end)"
+        );
+        assert!(found[1].message.contains("must be > previous t = 1 s"));
+        assert!(
+            found[2]
+                .message
+                .contains("must lie within the history's span [0, 13] s")
+        );
+        assert!(found[4].message.contains("first 6 decimals"));
+        let no_history = r#"{"material": {"kind": "preset", "name": "pzt4"},
+            "punch": {"radius": 0.06, "electrode": {"kind": "conducting", "charge": 6e-7}},
+            "friction": 0.3, "normal_load": 2000, "output": {"snapshots": [1.0]}}"#;
+        let found = issues_of(no_history);
+        assert_eq!(found[0].path, "output.snapshots");
+        assert!(found[0].message.contains("without a `tangential_history`"));
+    }
+
+    #[test]
+    fn snapshot_times_off_the_step_grid_become_history_points() {
+        // Default history: 10 steps on [0, 1] (max step 0.05 ηP over 0.5 ηP), so 0.3 is a step
+        // time and 0.35 is not. Splitting [0, 1] at 0.35 regrids [0, 0.35] into 10 steps
+        // 0.035 s apart, so 0.3 is then added as well; 0 and 13 (the ends) add nothing.
+        let text = with_output(r#"{"snapshots": [0.0, 0.3, 0.35, 13.0]}"#);
+        let s = validate(parse(&text, Path::new("t.json")).unwrap()).unwrap();
+        let h = s.history.unwrap();
+        assert_eq!(h.points.len(), 10);
+        let added: Vec<(f64, f64)> = h.points[1..3].to_vec();
+        assert!((added[0].0 - 0.3).abs() < 1e-15 && (added[0].1 - 90.0).abs() < 1e-9);
+        assert!((added[1].0 - 0.35).abs() < 1e-15 && (added[1].1 - 105.0).abs() < 1e-9);
+        assert_eq!(s.snapshots, [0.0, 0.3, 0.35, 13.0]);
+        assert!((s.time_tolerance - 1.3e-8).abs() < 1e-20);
+        assert_eq!(snapshot_stem(-0.0), "t_0.000000");
+        assert_eq!(snapshot_stem(2.5), "t_2.500000");
     }
 
     #[test]
