@@ -492,22 +492,36 @@ fn scenario_cattaneo_mindlin_uncoupled() {
     assert!(dq < 1e-8, "{dq:e}");
 }
 
-/// The coupled elastic case (seed Figure 4 contact) under three ±½ηP cycles: in the last cycle
-/// the loop area and the frictional work agree within the time-discretisation error (measured
-/// 5.7e−4 with 20 steps per half-cycle) and P does no net work; the verdict either reports a
-/// steady cycle or the cycle-to-cycle change that prevents it (measured: not settled, 2e−6,
-/// from the stick-end jump described in `contact::tangential`).
+/// The coupled elastic case (seed Figure 4 contact) under three ±½ηP cycles. Over a closed
+/// cycle (its end state equals its start state: the stick ends at +Qmax agree with the
+/// previous cycle's to 1e−9 a) the loop area equals the frictional work within the
+/// time-discretisation error (measured 5.7e−4 with 20 steps per half-cycle) and P does no net
+/// work (measured 2e−19 of the area); at least one cycle must close. Whether the later cycles
+/// close depends on the stick-end jump at the −½ηP arrival, which the one-zone form does not
+/// determine uniquely (see `contact::tangential`); the verdict must then report the change.
 #[test]
 fn scenario_figure4_fretting() {
     let (_tmp, _out, s) = run_scenario("figure4_fretting");
     let h = s.history.as_ref().unwrap();
-    let last = h.cycles.last().unwrap();
-    let (area, friction, normal) = (last.loop_area, last.friction_work, last.normal_work);
-    assert!(
-        ((friction - area) / area).abs() < 2e-3,
-        "{area:e} {friction:e}"
-    );
-    assert!(normal.abs() < 1e-9 * area);
+    let a = s.normal_loading.half_width;
+    let mut closed = 0;
+    for pair in h.cycles.windows(2) {
+        let (prev, cycle) = (&pair[0], &pair[1]);
+        let moved = (cycle.stick_at_max.0 - prev.stick_at_max.0)
+            .abs()
+            .max((cycle.stick_at_max.1 - prev.stick_at_max.1).abs());
+        if moved > 1e-9 * a {
+            continue;
+        }
+        closed += 1;
+        let (area, friction, normal) = (cycle.loop_area, cycle.friction_work, cycle.normal_work);
+        assert!(
+            ((friction - area) / area).abs() < 2e-3,
+            "{area:e} {friction:e}"
+        );
+        assert!(normal.abs() < 1e-9 * area, "{normal:e} {area:e}");
+    }
+    assert!(closed > 0, "no closed cycle");
     match h.verdict {
         Verdict::SteadyCyclicSlip { .. } => {}
         Verdict::NotSettled { last_change } => assert!(last_change.unwrap() > 0.0),
