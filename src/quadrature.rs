@@ -274,11 +274,14 @@ impl BoundedSeries {
     /// `(1/π)⨍ f(t)/(t − τ) dt` at any τ (inside: −Σ β_n T_n; outside: −Σ β_n zⁿ).
     pub fn cauchy(&self, tau: f64) -> f64 {
         if tau.abs() < 1.0 {
-            // −Σ_{n≥1} β_n T_n(τ)
-            let mut c = Vec::with_capacity(self.beta.len() + 1);
-            c.push(0.0);
-            c.extend(self.beta.iter().map(|b| -b));
-            chebyshev_t_sum(&c, tau)
+            // −Σ_{n≥1} β_n T_n(τ) by Clenshaw's recurrence (β_n multiplies T_n).
+            let (mut b1, mut b2) = (0.0, 0.0);
+            for &bn in self.beta.iter().rev() {
+                let b0 = 2.0 * tau * b1 - b2 - bn;
+                b2 = b1;
+                b1 = b0;
+            }
+            tau * b1 - b2
         } else {
             let z = exterior(tau);
             -z * power_sum(&self.beta, z)
