@@ -749,25 +749,120 @@ fn same_input_gives_the_same_bytes() {
     }
 }
 
+/// The default history on the paper's contact, as a JSON value to break one field at a time.
+fn valid_scenario() -> serde_json::Value {
+    serde_json::from_str(&short_history("[0.5]", "")).unwrap()
+}
+
+/// `valid_scenario()` with the value at a dotted path replaced.
+fn with(path: &str, value: serde_json::Value) -> String {
+    let mut v = valid_scenario();
+    let mut cur = &mut v;
+    let keys: Vec<&str> = path.split('.').collect();
+    for k in &keys[..keys.len() - 1] {
+        cur = &mut cur[*k];
+    }
+    cur[keys[keys.len() - 1]] = value;
+    v.to_string()
+}
+
+/// One case per rule of the scenario format: exit 2, stderr names the field (or the line of a
+/// JSON syntax error) and the rule, and nothing is written.
 #[test]
 fn bad_input_exits_2_names_the_field_and_writes_nothing() {
+    use serde_json::json;
     let tmp = tempfile::tempdir().unwrap();
-    let cases = [
-        ("{ \"name\": \"x\", ".to_string(), "line"),
+    let elastic = json!({"kind": "elastic", "shear_modulus": 27.3e9, "poisson_ratio": 0.3});
+    let not_pd = json!({"kind": "piezoelectric", "c11": 139e9, "c13": 74.3e9, "c33": 115e9,
+        "c44": -1.0, "e31": -5.2, "e33": 15.1, "e15": 12.7, "eps11": 6.461e-9, "eps33": 5.62e-9});
+    let mut elastic_with_charge = valid_scenario();
+    elastic_with_charge["material"] = elastic.clone();
+    let cases: Vec<(String, &str, &str)> = vec![
+        ("{ \"name\": \"x\", ".into(), "line", "EOF"),
+        (with("frictoin", json!(1.0)), "frictoin", "unknown field"),
         (
-            r#"{"material": {"kind": "preset", "name": "pzt4"}, "punch": {"radius": -1, "electrode": {"kind": "conducting", "charge": 6e-7}}, "friction": 0.3, "normal_load": 2000}"#.to_string(),
+            with("punch.radius", json!("big")),
             "punch.radius",
+            "invalid type",
         ),
         (
-            r#"{"material": {"kind": "preset", "name": "pzt4"}, "punch": {"radius": 0.06, "electrode": {"kind": "conducting", "charge": 6e-7}}, "friction": 0.3, "normal_load": 2000, "frictoin": 1}"#.to_string(),
-            "frictoin",
+            with("punch.radius", json!(-0.06)),
+            "punch.radius",
+            "must be finite and > 0",
         ),
-        (short_history("[0.5, 0.4, 7.0]", ""), "output.snapshots[1]"),
-        (short_history("[0.5, 0.4, 7.0]", ""), "output.snapshots[2]"),
-        (short_history("[0.5]", ", \"field_points\": 30"), "output.field_points"),
-        (short_history("[0.5]", ", \"plots\": false"), "plots"),
+        (
+            with("punch.radius", json!(0.0)),
+            "punch.radius",
+            "must be finite and > 0",
+        ),
+        (
+            with("normal_load", json!(0.0)),
+            "normal_load",
+            "must be finite and > 0",
+        ),
+        (
+            with("normal_load", json!(-2000.0)),
+            "normal_load",
+            "must be finite and > 0",
+        ),
+        (
+            with("numerics", json!({"collocation_points": 0})),
+            "numerics.collocation_points",
+            "[8, 1024]",
+        ),
+        (
+            with("numerics", json!({"cycle_tolerance": 0.0})),
+            "numerics.cycle_tolerance",
+            "(0, 1)",
+        ),
+        (
+            with("numerics", json!({"cycle_tolerance": 2.0})),
+            "numerics.cycle_tolerance",
+            "(0, 1)",
+        ),
+        (with("friction", json!(-0.3)), "friction", "≥ 0"),
+        (
+            with("material.name", json!("pzt99")),
+            "material.name",
+            "must be one of",
+        ),
+        (with("material", not_pd), "material.c44", "invalid"),
+        (
+            with(
+                "tangential_history.points",
+                json!([[0.0, 0.0], [1.0, 0.3], [0.5, 0.1]]),
+            ),
+            "tangential_history.points[2].t",
+            "must be > previous t",
+        ),
+        (
+            with("tangential_history.points", json!([[0.0, 0.0], [1.0, 1.0]])),
+            "tangential_history.points[1].q",
+            "|Q| < ηP",
+        ),
+        (
+            elastic_with_charge.to_string(),
+            "punch.electrode",
+            "elastic half-plane",
+        ),
+        (
+            with("output.snapshots", json!([0.5, 0.4])),
+            "output.snapshots[1]",
+            "must be > previous t",
+        ),
+        (
+            with("output.snapshots", json!([7.0])),
+            "output.snapshots[0]",
+            "within the history's span",
+        ),
+        (
+            with("output.field_points", json!(30)),
+            "output.field_points",
+            "multiple of 4",
+        ),
+        (with("output.plots", json!(false)), "plots", "unknown field"),
     ];
-    for (i, (text, needle)) in cases.iter().enumerate() {
+    for (i, (text, field, rule)) in cases.iter().enumerate() {
         let file = tmp.path().join(format!("bad{i}.json"));
         std::fs::write(&file, text).unwrap();
         let out = tmp.path().join(format!("out{i}"));
@@ -778,9 +873,9 @@ fn bad_input_exits_2_names_the_field_and_writes_nothing() {
             .arg(&out)
             .output()
             .unwrap();
-        assert_eq!(o.status.code(), Some(2), "case {i}");
+        assert_eq!(o.status.code(), Some(2), "case {i} ({field})");
         let err = String::from_utf8_lossy(&o.stderr);
-        assert!(err.contains(needle), "case {i}: {err}");
+        assert!(err.contains(field) && err.contains(rule), "case {i}: {err}");
         assert!(!out.exists(), "case {i} wrote output");
     }
     let o = fretsim()
