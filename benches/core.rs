@@ -96,7 +96,7 @@ fn steps(c: &mut Criterion) {
     bench_step(
         c,
         "solve/forward_step",
-        &[32, 64, 128],
+        &[32, 64, 128, 256, 512],
         &[0.1, 0.2, 0.3],
         0.35,
     );

@@ -200,9 +200,11 @@ pub struct StepRecord {
     pub left_slip_sign: f64,
     /// `q/(ηp)` in the right slip zone.
     pub right_slip_sign: f64,
-    /// Block iterations.
+    /// (Quasi-)Newton iterations on the step's geometry (stick ends, a, c) in the accepted
+    /// attempt (`newton_iterations` in `steps.csv`).
     pub iterations: usize,
-    /// Newton iterations of the stick-zone ends.
+    /// Residual evaluations of the accepted attempt, each a coupled linear solve at fixed
+    /// geometry, including those of finite-difference Jacobians (`evaluations` in `steps.csv`).
     pub newton_iterations: usize,
     /// Final relative change of the block iteration.
     pub residual: f64,

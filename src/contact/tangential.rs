@@ -114,9 +114,10 @@ pub struct StepAdmissibility {
 pub struct SlipStep {
     /// The new state.
     pub state: ContactState,
-    /// Newton iterations.
+    /// (Quasi-)Newton iterations of the accepted attempt.
     pub iterations: usize,
-    /// Residual evaluations (each a coupled linear solve at fixed geometry).
+    /// Residual evaluations of the accepted attempt (each a coupled linear solve at fixed
+    /// geometry), including those of finite-difference Jacobians.
     pub newton_iterations: usize,
     /// Final residual norm.
     pub residual: f64,
@@ -666,8 +667,8 @@ enum Method {
     /// Broyden's updates from the given Jacobian (or a finite-difference one), within the
     /// evaluation budget.
     Broyden(Option<[[f64; 4]; 4]>),
-    /// Newton's method with a finite-difference Jacobian at every iterate and no evaluation
-    /// budget: slower, and the fallback where the quasi-Newton attempts all fail.
+    /// Newton's method with a finite-difference Jacobian at every iterate and five times the
+    /// evaluation budget: slower, and the fallback where the quasi-Newton attempts all fail.
     Newton,
 }
 
@@ -734,7 +735,9 @@ fn solve_geometry(
                 jacobian: jac.unwrap_or([[0.0; 4]; 4]),
             });
         }
-        if broyden && evaluations > options.max_evaluations {
+        // Newton's fallback gets a larger budget: it needs 5 evaluations per iteration.
+        let budget = if broyden { 1 } else { 5 } * options.max_evaluations;
+        if evaluations > budget {
             break;
         }
         let j = match jac {
