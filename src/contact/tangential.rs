@@ -48,11 +48,18 @@
 //! - Stick ends can jump when the load passes an earlier turning point (Masing memory) or when
 //!   a plateau of the traction reaches the friction limit: the earlier stick/slip boundaries of
 //!   the memory are tried as starting points.
-//! - Known limitation: in coupled contacts the normal-loading memory can leave a plateau of
-//!   `q ≈ −0.93 ηp` inside the stick zone during reverse slip; the traction profile is then
-//!   non-monotone, the physical state has a slip zone inside the stick zone, and the one-zone
-//!   form admits only a jump whose size depends on the load step (aluminium, Figure-4 case:
-//!   the −½ηP turning point has lo = −0.18a with 5 steps per half-cycle and −0.63a with 10).
+//! - Known limitation: in coupled contacts the memory can leave a plateau of
+//!   `q ≈ −0.93 ηp` inside the stick zone during reverse slip, ending in a cusp at an earlier
+//!   stick/slip boundary. At the −½ηP arrival of the PZT-4 default history (M = 64) both
+//!   stick ends reach earlier boundaries; on one side of each the residuals are nearly flat in
+//!   the ends, across it they jump by about 2e−4 (the inherited correction switches between
+//!   whole and faded), so there is no root and the iteration stalls at 3e−6–4e−6. The
+//!   remembered-boundary guesses then find a jump to an earlier zone, whose landing point
+//!   depends on the load step and on M (aluminium, Figure-4 case: lo = −0.18a with 5 steps
+//!   per half-cycle and −0.63a with 10; PZT-4: a jump at M = 32 and 64, none at M = 48 and
+//!   96, where the −½ηP zone is close to the mirror image of the +½ηP zone; see
+//!   `docs/performance.md`). A representation that is continuous across earlier boundaries
+//!   (or a state whose end is pinned at one) is needed.
 //!
 //! # Checks
 //! `p ≥ 0`; `|q| ≤ ηp` on the stick zone; and in each slip zone the slip increment since the
