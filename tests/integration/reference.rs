@@ -716,3 +716,80 @@ fn cycle_verdicts() {
     let (_, verdict) = analyse_cycles(&growing, 1e-6);
     assert!(matches!(verdict, Verdict::NotSettled { .. }), "{verdict:?}");
 }
+
+/// Mirror symmetry of the solver. PZT-4 poled normal to the surface is symmetric under
+/// x → −x, under which q, Q, the eccentricity, the tangential displacement δ and the slip
+/// directions change sign and p, g do not; so the history −Q(t) must give the mirror image of
+/// the history Q(t) at every step: stick zone [lo, hi] → [−hi, −lo], e → −e, δ → −δ, left and
+/// right slip signs exchanged and negated, the same a and dissipation. Run on the paper's
+/// baseline through two reversals of a coupled contact (0 → ½ → −½ → ½ ηP in steps of
+/// 0.05 ηP), where a direction-dependent choice in the state machine (the order in which
+/// slip states are tried, the guesses) would break it. Measured: stick ends, e and a to 5e−14 a,
+/// δ to 1.8e−12 and the dissipation to 6e−13 of their largest values (round-off).
+#[test]
+fn history_is_mirror_symmetric() {
+    use fretsim::contact::normal::{NormalOptions, solve_normal};
+    use fretsim::contact::tangential::SlipOptions;
+    use fretsim::history::{LoadHistory, NoObserver, run_history};
+    let sc = fretsim::scenario::default_scenario();
+    let (model, p) = (&sc.model, sc.normal_load);
+    let lim = model.friction * p;
+    let disc = Discretisation::new(64);
+    let normal = solve_normal(model, &disc, p, NormalOptions::default()).unwrap();
+    let run = |s: f64| {
+        let history = LoadHistory {
+            points: vec![
+                (0.0, 0.0),
+                (1.0, 0.5 * s * lim),
+                (3.0, -0.5 * s * lim),
+                (5.0, 0.5 * s * lim),
+            ],
+            steps_per_segment: 10,
+            max_step: 0.05 * lim,
+        };
+        run_history(
+            model,
+            &disc,
+            &normal,
+            &history,
+            SlipOptions::default(),
+            &mut NoObserver,
+        )
+        .unwrap()
+        .records
+    };
+    let (plus, minus) = (run(1.0), run(-1.0));
+    assert_eq!(plus.len(), 51, "{}", plus.len());
+    assert_eq!(plus.len(), minus.len());
+    let a = normal.state.half_width;
+    let largest = |f: &dyn Fn(&fretsim::history::StepRecord) -> f64| {
+        plus.iter().map(|r| f(r).abs()).fold(0.0, f64::max)
+    };
+    let (delta_scale, dissipation_scale) =
+        (largest(&|r| r.displacement), largest(&|r| r.dissipation));
+    let mut worst = [0.0f64; 6];
+    for (x, y) in plus.iter().zip(&minus) {
+        assert_eq!(x.phase, y.phase);
+        assert_eq!(
+            (x.left_slip_sign, x.right_slip_sign),
+            (-y.right_slip_sign, -y.left_slip_sign),
+            "step {}",
+            x.step
+        );
+        for (w, d) in worst.iter_mut().zip([
+            (x.stick_lo + y.stick_hi) / a,
+            (x.stick_hi + y.stick_lo) / a,
+            (x.eccentricity + y.eccentricity) / a,
+            (x.half_width - y.half_width) / a,
+            (x.displacement + y.displacement) / delta_scale,
+            (x.dissipation - y.dissipation) / dissipation_scale,
+        ]) {
+            *w = w.max(d.abs());
+        }
+    }
+    eprintln!("mirror mismatch (lo, hi, e, a, δ, dissipation): {worst:?}");
+    // Round-off: the geometry to 1e−12 of a; δ (a sum of differences of quadratures) and the
+    // dissipation to 1e−10 of their largest values.
+    assert!(worst[..4].iter().all(|w| *w < 1e-12), "{worst:?}");
+    assert!(worst[4..].iter().all(|w| *w < 1e-10), "{worst:?}");
+}
