@@ -17,6 +17,34 @@ fn max_error(f: impl Fn(f64) -> f64, g: impl Fn(f64) -> f64, a: f64, scale: f64)
         .fold(0.0, f64::max)
 }
 
+/// The step records of a load history (points `(t, Q)`) run from the end of normal loading.
+fn step_records(
+    model: &ContactModel,
+    disc: &Discretisation,
+    normal: &fretsim::contact::normal::NormalLoading,
+    points: Vec<(f64, f64)>,
+    steps_per_segment: usize,
+    max_step: f64,
+) -> Vec<fretsim::history::StepRecord> {
+    use fretsim::contact::tangential::SlipOptions;
+    use fretsim::history::{LoadHistory, NoObserver, run_history};
+    let history = LoadHistory {
+        points,
+        steps_per_segment,
+        max_step,
+    };
+    run_history(
+        model,
+        disc,
+        normal,
+        &history,
+        SlipOptions::default(),
+        &mut NoObserver,
+    )
+    .unwrap()
+    .records
+}
+
 #[test]
 fn reference_hertz_line_contact() {
     let model = ContactModel::new(Material::Elastic(ALUMINIUM), 10e-3, 0.0, Electrode::None);
@@ -577,8 +605,6 @@ fn normal_loading_converges_in_m() {
 fn reference_fretting_loop_uncoupled() {
     use fretsim::analytical::CattaneoMindlin;
     use fretsim::contact::normal::{NormalOptions, solve_normal};
-    use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{LoadHistory, NoObserver, run_history};
     use fretsim::material::IsotropicConstants;
     let iso = IsotropicConstants {
         shear_modulus: 27.3e9,
@@ -604,21 +630,7 @@ fn reference_fretting_loop_uncoupled() {
             (2.0, -0.5 * lim),
             (3.0, 0.5 * lim),
         ];
-        let history = LoadHistory {
-            points,
-            steps_per_segment: 40,
-            max_step: lim,
-        };
-        let recs = run_history(
-            &model,
-            &disc,
-            &normal,
-            &history,
-            SlipOptions::default(),
-            &mut NoObserver,
-        )
-        .unwrap()
-        .records;
+        let recs = step_records(&model, &disc, &normal, points, 40, lim);
         let scale = y11 * lim / std::f64::consts::PI;
         let mut worst = 0.0f64;
         for r in &recs[1..] {
@@ -671,8 +683,6 @@ fn reference_fretting_loop_uncoupled() {
 fn cycle_verdicts() {
     use fretsim::app::{Verdict, analyse_cycles};
     use fretsim::contact::normal::{NormalOptions, solve_normal};
-    use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{LoadHistory, NoObserver, run_history};
     use fretsim::material::IsotropicConstants;
     let iso = IsotropicConstants {
         shear_modulus: 27.3e9,
@@ -688,21 +698,7 @@ fn cycle_verdicts() {
         for (i, a) in amps.iter().enumerate() {
             pts.push((pts.len() as f64, if i % 2 == 0 { *a } else { -*a } * lim));
         }
-        let history = LoadHistory {
-            points: pts,
-            steps_per_segment: 10,
-            max_step: lim,
-        };
-        run_history(
-            &model,
-            &disc,
-            &normal,
-            &history,
-            SlipOptions::default(),
-            &mut NoObserver,
-        )
-        .unwrap()
-        .records
+        step_records(&model, &disc, &normal, pts, 10, lim)
     };
     let steady = run(&[0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5]);
     let (cycles, verdict) = analyse_cycles(&steady, 1e-6);
@@ -729,34 +725,19 @@ fn cycle_verdicts() {
 #[test]
 fn history_is_mirror_symmetric() {
     use fretsim::contact::normal::{NormalOptions, solve_normal};
-    use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{LoadHistory, NoObserver, run_history};
     let sc = fretsim::scenario::default_scenario();
     let (model, p) = (&sc.model, sc.normal_load);
     let lim = model.friction * p;
     let disc = Discretisation::new(64);
     let normal = solve_normal(model, &disc, p, NormalOptions::default()).unwrap();
     let run = |s: f64| {
-        let history = LoadHistory {
-            points: vec![
-                (0.0, 0.0),
-                (1.0, 0.5 * s * lim),
-                (3.0, -0.5 * s * lim),
-                (5.0, 0.5 * s * lim),
-            ],
-            steps_per_segment: 10,
-            max_step: 0.05 * lim,
-        };
-        run_history(
-            model,
-            &disc,
-            &normal,
-            &history,
-            SlipOptions::default(),
-            &mut NoObserver,
-        )
-        .unwrap()
-        .records
+        let points = vec![
+            (0.0, 0.0),
+            (1.0, 0.5 * s * lim),
+            (3.0, -0.5 * s * lim),
+            (5.0, 0.5 * s * lim),
+        ];
+        step_records(model, &disc, &normal, points, 10, 0.05 * lim)
     };
     let (plus, minus) = (run(1.0), run(-1.0));
     assert_eq!(plus.len(), 51, "{}", plus.len());
