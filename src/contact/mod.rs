@@ -350,18 +350,7 @@ impl Inherited {
         if !self.faded() {
             return self.zone.correction_integral();
         }
-        let (nodes, weights) = graded_rule();
-        self.pieces()
-            .windows(2)
-            .map(|w| {
-                let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-                nodes
-                    .iter()
-                    .zip(weights)
-                    .map(|(u, wt)| wt * half * self.value(mid + half * u))
-                    .sum::<f64>()
-            })
-            .sum()
+        graded_integral(self.pieces(), &|x| self.value(x))
     }
 }
 
