@@ -143,5 +143,47 @@ fn cycle(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, kernels, normal, steps, reversal, cycle);
+/// The load steps (fractions of ηP) of the default history: 0 → ½, then ±½ cycles, in steps of
+/// 0.05.
+fn default_loads(cycles: usize) -> Vec<f64> {
+    let mut loads: Vec<f64> = (1..=10).map(|i| 0.05 * i as f64).collect();
+    for _ in 0..cycles {
+        loads.extend((1..=20).map(|i| 0.5 - 0.05 * i as f64));
+        loads.extend((1..=20).map(|i| -0.5 + 0.05 * i as f64));
+    }
+    loads
+}
+
+fn steady_cycle(c: &mut Criterion) {
+    // One cycle (40 steps, +½ → −½ → +½ ηP) of the default history after its lead-in and
+    // first cycle, from a clone of the driver.
+    let sc = default_scenario();
+    let mut g = c.benchmark_group("cycle/steady_cycle");
+    g.sample_size(10);
+    for m in [32, 64] {
+        let disc = Discretisation::new(m);
+        let before = default_loads(1);
+        let driver = driver_after(&sc, &disc, &before);
+        let cycle = &default_loads(2)[before.len()..];
+        g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
+            b.iter(|| {
+                let mut d = driver.clone();
+                for (k, f) in cycle.iter().enumerate() {
+                    black_box(step(&sc, &disc, &mut d, before.len() + k + 1, *f));
+                }
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    kernels,
+    normal,
+    steps,
+    reversal,
+    cycle,
+    steady_cycle
+);
 criterion_main!(benches);
