@@ -17,6 +17,31 @@ fn max_error(f: impl Fn(f64) -> f64, g: impl Fn(f64) -> f64, a: f64, scale: f64)
         .fold(0.0, f64::max)
 }
 
+/// The uncoupled Hertzian line contact of the Cattaneo–Mindlin tests (elastic, μ = 27.3 GPa,
+/// ν = 0.5 so that Dundurs' β = 0; R = 10 mm, η = 0.3) at P = 2240 N/m, with its closed form.
+struct Uncoupled {
+    model: ContactModel,
+    p_load: f64,
+    exact: fretsim::analytical::CattaneoMindlin,
+}
+
+fn uncoupled() -> Uncoupled {
+    let iso = fretsim::material::IsotropicConstants {
+        shear_modulus: 27.3e9,
+        poisson_ratio: 0.5,
+    };
+    let (p_load, eta, radius) = (2240.0, 0.3, 10e-3);
+    Uncoupled {
+        model: ContactModel::new(Material::Elastic(iso), radius, eta, Electrode::None),
+        p_load,
+        exact: fretsim::analytical::CattaneoMindlin::new(
+            Hertz::new(p_load, radius, 2.0 / iso.plane_strain_modulus()),
+            eta,
+            p_load,
+        ),
+    }
+}
+
 /// The step records of a load history (points `(t, Q)`) run from the end of normal loading.
 fn step_records(
     model: &ContactModel,
@@ -384,23 +409,15 @@ fn friction_limits_tend_to_frictionless_and_to_full_stick() {
 /// 2e−3): the tolerances below would catch that regression.
 #[test]
 fn reference_cattaneo_mindlin_deresiewicz_masing() {
-    use fretsim::analytical::CattaneoMindlin;
     use fretsim::contact::normal::{NormalOptions, solve_normal};
     use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{LoadHistory, NoObserver, run_history};
-    use fretsim::material::IsotropicConstants;
-    let iso = IsotropicConstants {
-        shear_modulus: 27.3e9,
-        poisson_ratio: 0.5,
-    };
-    let (p_load, eta, radius) = (2240.0, 0.3, 10e-3);
-    let model = ContactModel::new(Material::Elastic(iso), radius, eta, Electrode::None);
-    let exact = CattaneoMindlin::new(
-        Hertz::new(p_load, radius, 2.0 / iso.plane_strain_modulus()),
-        eta,
+    use fretsim::history::{LoadHistory, run_history};
+    let Uncoupled {
+        model,
         p_load,
-    );
-    let lim = eta * p_load;
+        exact,
+    } = uncoupled();
+    let lim = model.friction * p_load;
     let turning = [0.0, 0.6, 0.2, 0.6, 0.8];
     let points: Vec<(f64, f64)> = turning
         .iter()
@@ -420,9 +437,8 @@ fn reference_cattaneo_mindlin_deresiewicz_masing() {
         let records = run_history(&model, &disc, &normal, &history, opts, &mut recorder)
             .unwrap()
             .records;
-        let _ = NoObserver;
         let a = exact.half_width;
-        let scale = eta * exact.peak_pressure;
+        let scale = model.friction * exact.peak_pressure;
         let (mut err_c, mut err_q) = (0.0f64, 0.0f64);
         for (rec, state) in records.iter().zip(&recorder.states).skip(1) {
             let phase = (rec.t - 1e-9).floor() as usize; // segment index
@@ -603,25 +619,17 @@ fn normal_loading_converges_in_m() {
 /// the area's independence of d.
 #[test]
 fn reference_fretting_loop_uncoupled() {
-    use fretsim::analytical::CattaneoMindlin;
     use fretsim::contact::normal::{NormalOptions, solve_normal};
-    use fretsim::material::IsotropicConstants;
-    let iso = IsotropicConstants {
-        shear_modulus: 27.3e9,
-        poisson_ratio: 0.5,
-    };
-    let (p_load, eta, radius) = (2240.0, 0.3, 10e-3);
-    let lim = eta * p_load;
+    let Uncoupled {
+        model,
+        p_load,
+        exact,
+    } = uncoupled();
+    let lim = model.friction * p_load;
     let mut areas = Vec::new();
     for d in [1e-2, 1e-1] {
-        let model = ContactModel::new(Material::Elastic(iso), radius, eta, Electrode::None)
-            .with_reference_distance(d);
+        let model = model.clone().with_reference_distance(d);
         let y11 = model.compliance.y11;
-        let exact = CattaneoMindlin::new(
-            Hertz::new(p_load, radius, 2.0 / iso.plane_strain_modulus()),
-            eta,
-            p_load,
-        );
         let disc = Discretisation::new(32);
         let normal = solve_normal(&model, &disc, p_load, NormalOptions::default()).unwrap();
         let points = vec![
@@ -683,14 +691,8 @@ fn reference_fretting_loop_uncoupled() {
 fn cycle_verdicts() {
     use fretsim::app::{Verdict, analyse_cycles};
     use fretsim::contact::normal::{NormalOptions, solve_normal};
-    use fretsim::material::IsotropicConstants;
-    let iso = IsotropicConstants {
-        shear_modulus: 27.3e9,
-        poisson_ratio: 0.5,
-    };
-    let (p_load, eta) = (2240.0, 0.3);
-    let lim = eta * p_load;
-    let model = ContactModel::new(Material::Elastic(iso), 10e-3, eta, Electrode::None);
+    let Uncoupled { model, p_load, .. } = uncoupled();
+    let lim = model.friction * p_load;
     let disc = Discretisation::new(32);
     let normal = solve_normal(&model, &disc, p_load, NormalOptions::default()).unwrap();
     let run = |amps: &[f64]| {
