@@ -455,11 +455,12 @@ fn scenario_figure3_history_insulating() {
     assert!(rows.iter().all(|r| r[3] == 0.0));
 }
 
-/// Largest difference of the shear traction q between two field files, relative to the peak
-/// pressure of the first.
-fn traction_difference(a: &Path, b: &Path) -> f64 {
-    let (_, fa) = read_csv(a);
-    let (_, fb) = read_csv(b);
+/// Largest difference of the shear traction q between the snapshot files of times `a` and `b`
+/// (s), relative to the peak pressure at `a`.
+fn traction_difference(out: &Path, a: f64, b: f64) -> f64 {
+    let file = |t: f64| out.join(format!("fields/t_{t:.6}.csv"));
+    let (_, fa) = read_csv(&file(a));
+    let (_, fb) = read_csv(&file(b));
     let p0 = fa.iter().map(|r| r[1].abs()).fold(0.0, f64::max);
     fa.iter()
         .zip(&fb)
@@ -485,10 +486,7 @@ fn scenario_cattaneo_mindlin_uncoupled() {
     let ratio = |k: usize| s.snapshots[k].stick_hi / s.snapshots[k].half_width;
     assert!((ratio(0) - 0.4f64.sqrt()).abs() < 1e-9, "{}", ratio(0));
     assert!((ratio(2) - 0.8f64.sqrt()).abs() < 1e-9, "{}", ratio(2));
-    let dq = traction_difference(
-        &out.join("fields/t_1.000000.csv"),
-        &out.join("fields/t_3.000000.csv"),
-    );
+    let dq = traction_difference(&out, 1.0, 3.0);
     assert!(dq < 1e-8, "{dq:e}");
 }
 
@@ -538,11 +536,8 @@ fn scenario_many_cycles() {
     assert_eq!(h.cycles.len(), 10);
     assert_eq!(h.verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 });
     assert_eq!(snapshot_loads(&s), [0.5, -0.5, 0.5, -0.5]);
-    for (a, b) in [("1", "37"), ("3", "39")] {
-        let dq = traction_difference(
-            &out.join(format!("fields/t_{a}.000000.csv")),
-            &out.join(format!("fields/t_{b}.000000.csv")),
-        );
+    for (a, b) in [(1.0, 37.0), (3.0, 39.0)] {
+        let dq = traction_difference(&out, a, b);
         assert!(dq < 1e-8, "{a} s vs {b} s: {dq:e}");
     }
 }
@@ -563,11 +558,8 @@ fn scenario_variable_amplitude() {
     assert!(h.cycles[3].change.unwrap() > 1e-3);
     assert_eq!(h.verdict, Verdict::SteadyCyclicSlip { from_cycle: 4 });
     assert_eq!(snapshot_loads(&s), [-0.6, 0.6, -0.6, 0.6]);
-    for (a, b) in [("4", "12"), ("5", "13")] {
-        let dq = traction_difference(
-            &out.join(format!("fields/t_{a}.000000.csv")),
-            &out.join(format!("fields/t_{b}.000000.csv")),
-        );
+    for (a, b) in [(4.0, 12.0), (5.0, 13.0)] {
+        let dq = traction_difference(&out, a, b);
         assert!(dq < 1e-8, "{a} s vs {b} s: {dq:e}");
     }
 }
@@ -588,10 +580,7 @@ fn scenario_partial_unload_reload() {
             "forward_slip"
         ]
     );
-    let dq = traction_difference(
-        &out.join("fields/t_1.000000.csv"),
-        &out.join("fields/t_3.000000.csv"),
-    );
+    let dq = traction_difference(&out, 1.0, 3.0);
     eprintln!("PZT-4 reload to the earlier maximum: q differs by {dq:.2e} p0");
     assert!(dq < 1e-4, "{dq:e}");
 }
