@@ -104,8 +104,7 @@ fn steps(c: &mut Criterion) {
 
 fn reversal(c: &mut Criterion) {
     // The first step after the turning point at +½ηP.
-    let loads: Vec<f64> = (1..=10).map(|i| 0.05 * i as f64).collect();
-    bench_step(c, "solve/reversal_step", &[32, 64], &loads, 0.45);
+    bench_step(c, "solve/reversal_step", &[32, 64], &default_loads(0), 0.45);
 }
 
 fn cycle(c: &mut Criterion) {

@@ -281,6 +281,8 @@ pub struct DriverState {
     last_dissipation: f64,
     /// Work of P in the last step (J/m).
     last_normal_work: f64,
+    /// Normal approach δn of the current state (m), once computed.
+    approach: Option<f64>,
     /// Electric work in the last step (J/m).
     last_electric_work: f64,
     /// Slip signs and Jacobian of the last step, the warm start of the next step of a phase.
@@ -306,6 +308,7 @@ impl DriverState {
             displacement: 0.0,
             last_dissipation: 0.0,
             last_normal_work: 0.0,
+            approach: None,
             last_electric_work: 0.0,
             warm: None,
         }
@@ -450,8 +453,12 @@ pub fn advance(
     driver.last_dissipation = dissipation;
     let old = &driver.state;
     let new = &solved.state;
-    driver.last_normal_work =
-        new.normal_load * (new.normal_approach(model) - old.normal_approach(model));
+    let old_approach = driver
+        .approach
+        .unwrap_or_else(|| old.normal_approach(model));
+    let new_approach = new.normal_approach(model);
+    driver.approach = Some(new_approach);
+    driver.last_normal_work = new.normal_load * (new_approach - old_approach);
     driver.last_electric_work = match (old.potential, new.potential) {
         (Some(a), Some(b)) => 0.5 * (a + b) * (new.charge - old.charge),
         _ => 0.0,

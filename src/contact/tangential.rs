@@ -198,24 +198,13 @@ impl StepProblem<'_> {
             super::Electrode::ConductingPotential { .. }
         );
         let (mid, half) = (0.5 * (g.lo + g.hi), 0.5 * (g.hi - g.lo));
-        let stick_points: Vec<f64> = disc
-            .bounded
-            .collocation
-            .iter()
-            .map(|t| mid + half * t)
-            .collect();
-        let pressure_points: Vec<f64> = disc
-            .bounded
-            .collocation
-            .iter()
-            .map(|t| g.c + g.a * t)
-            .collect();
-        let charge_points: Vec<f64> = disc
-            .unbounded
-            .collocation
-            .iter()
-            .map(|t| g.c + g.a * t)
-            .collect();
+        // Collocation points mapped onto an interval `centre ± half`.
+        let mapped = |points: &[f64], centre: f64, half: f64| -> Vec<f64> {
+            points.iter().map(|t| centre + half * t).collect()
+        };
+        let stick_points = mapped(&disc.bounded.collocation, mid, half);
+        let pressure_points = mapped(&disc.bounded.collocation, g.c, g.a);
+        let charge_points = mapped(&disc.unbounded.collocation, g.c, g.a);
         // Parts of the stick right-hand side that do not change in the inner iteration.
         let fixed: Vec<f64> = stick_points
             .iter()
@@ -376,7 +365,7 @@ impl StepProblem<'_> {
 /// plain iteration contracts only by the coupling factor per step.
 struct Anderson {
     depth: usize,
-    /// Previous `x` and `F(x)`.
+    /// Previous residual `F(x) − x` and `F(x)`.
     last: Option<(Vec<f64>, Vec<f64>)>,
     /// Differences of residuals and of F values, newest last.
     d_res: Vec<Vec<f64>>,
@@ -396,8 +385,7 @@ impl Anderson {
     /// Replace `x` by the next iterate given `fx = F(x)`.
     fn next(&mut self, x: &mut [f64], fx: &[f64]) {
         let res: Vec<f64> = fx.iter().zip(x.iter()).map(|(f, v)| f - v).collect();
-        if let Some((x_old, f_old)) = self.last.take() {
-            let r_old: Vec<f64> = f_old.iter().zip(&x_old).map(|(f, v)| f - v).collect();
+        if let Some((r_old, f_old)) = self.last.take() {
             self.d_res
                 .push(res.iter().zip(&r_old).map(|(a, b)| a - b).collect());
             self.d_f
@@ -407,7 +395,7 @@ impl Anderson {
                 self.d_f.remove(0);
             }
         }
-        self.last = Some((x.to_vec(), fx.to_vec()));
+        self.last = Some((res.clone(), fx.to_vec()));
         x.copy_from_slice(fx);
         let k = self.d_res.len();
         if k == 0 {
@@ -415,7 +403,7 @@ impl Anderson {
         }
         // Normal equations of min |res − ΔR γ| (k ≤ depth), lightly regularised.
         let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(u, v)| u * v).sum::<f64>();
-        let gram: Vec<Vec<f64>> = self
+        let mut gram: Vec<Vec<f64>> = self
             .d_res
             .iter()
             .map(|di| {
@@ -424,7 +412,6 @@ impl Anderson {
                 row
             })
             .collect();
-        let mut gram = gram;
         let trace: f64 = (0..k).map(|i| gram[i][i]).sum::<f64>().max(1e-300);
         for (i, row) in gram.iter_mut().enumerate() {
             row[i] += 1e-12 * trace;
@@ -470,31 +457,14 @@ fn norm(r: &[f64; 4]) -> f64 {
     r.iter().map(|v| v * v).sum::<f64>().sqrt()
 }
 
-/// Solve the 4×4 linear system `J dx = −r` by Gaussian elimination with partial pivoting.
-#[allow(clippy::needless_range_loop)]
-fn solve4(mut j: [[f64; 4]; 4], r: [f64; 4]) -> Option<[f64; 4]> {
-    let mut b = r.map(|v| -v);
-    for col in 0..4 {
-        let piv = (col..4).max_by(|&x, &y| j[x][col].abs().total_cmp(&j[y][col].abs()))?;
-        if j[piv][col].abs() < 1e-300 {
-            return None;
-        }
-        j.swap(col, piv);
-        b.swap(col, piv);
-        for row in col + 1..4 {
-            let f = j[row][col] / j[col][col];
-            for k in col..4 {
-                j[row][k] -= f * j[col][k];
-            }
-            b[row] -= f * b[col];
-        }
-    }
-    let mut x = [0.0; 4];
-    for row in (0..4).rev() {
-        let s: f64 = (row + 1..4).map(|k| j[row][k] * x[k]).sum();
-        x[row] = (b[row] - s) / j[row][row];
-    }
-    x.iter().all(|v| v.is_finite()).then_some(x)
+/// Solve the 4×4 linear system `J dx = −r` (see [`solve_small`]).
+fn solve4(j: [[f64; 4]; 4], r: [f64; 4]) -> Option<[f64; 4]> {
+    let rows = j
+        .iter()
+        .zip(r)
+        .map(|(row, ri)| row.iter().copied().chain([-ri]).collect())
+        .collect();
+    solve_small(rows).map(|x| [x[0], x[1], x[2], x[3]])
 }
 
 /// What a step passes to the next one of the same phase: its slip signs and Jacobian.
@@ -634,6 +604,11 @@ fn fd_jacobian(
     // square-root behaviour at its ends).
     let room = (g.lo - (g.c - g.a)).min(g.c + g.a - g.hi);
     let d = (1e-6 * g.a).min(0.1 * room).max(1e-10 * g.a);
+    let chosen = state
+        .traction
+        .stick
+        .as_ref()
+        .and_then(|z| z.inherited.clone());
     let mut jac = [[0.0; 4]; 4];
     for k in 0..4 {
         let mut gk = *g;
@@ -655,12 +630,7 @@ fn fd_jacobian(
                 d
             }
         };
-        let chosen = state
-            .traction
-            .stick
-            .as_ref()
-            .and_then(|z| z.inherited.clone());
-        let (rk, _) = problem.evaluate_with(&gk, state, chosen)?;
+        let (rk, _) = problem.evaluate_with(&gk, state, chosen.clone())?;
         for i in 0..4 {
             jac[i][k] = (rk[i] - r[i]) / step;
         }

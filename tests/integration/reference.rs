@@ -403,8 +403,8 @@ fn friction_limits_tend_to_frictionless_and_to_full_stick() {
 /// Every correction in this limit is `const·√(c² − x²)` on a stick zone, which the bounded
 /// representation holds exactly, and each phase inherits the previous corrections in closed
 /// form, so the whole history is reproduced to the solver tolerance at every M (measured:
-/// |Δc|/a ≈ 9e−14; |Δq|/(ηp0) = 1.5e−8, 3.3e−8, 9.1e−8 for M = 32, 64, 128, round-off of the
-/// Chebyshev sums growing with M). Without the inheritance the memory's
+/// |Δc|/a = 2.7e−15, 1.1e−14, 1.2e−14 and |Δq|/(ηp0) = 1.5e−8, 4.1e−8, 7.7e−8 for M = 32, 64,
+/// 128, round-off of the Chebyshev sums growing with M). Without the inheritance the memory's
 /// square-root kinks at the old stick ends limited this to first order (|Δc|/a = 7e−3, 4e−3,
 /// 2e−3): the tolerances below would catch that regression.
 #[test]
