@@ -277,6 +277,8 @@ pub struct DriverState {
     phase_start_load: f64,
     /// Accumulated punch displacement δ (m).
     pub displacement: f64,
+    /// The material point at which δ is followed while it sticks (m).
+    anchor: f64,
     /// Dissipation of the last step (J/m).
     last_dissipation: f64,
     /// Work of P in the last step (J/m).
@@ -306,6 +308,12 @@ impl DriverState {
             base,
             phase_start_load: 0.0,
             displacement: 0.0,
+            anchor: normal
+                .state
+                .traction
+                .stick
+                .as_ref()
+                .map_or(0.0, |z| z.mid()),
             last_dissipation: 0.0,
             last_normal_work: 0.0,
             approach: None,
@@ -448,7 +456,27 @@ pub fn advance(
         driver.history.clear();
         observer.on_phase(driver.phase, &driver.memory);
     }
-    let (d_delta, dissipation) = step_increments(model, &driver.state, &solved.state);
+    // Keep the anchor of δ while it sticks; otherwise take the middle of the part of the old
+    // stick zone that still sticks.
+    let new_zone = solved.state.traction.stick.as_ref().expect("slip state");
+    let margin = 1e-3 * (new_zone.hi - new_zone.lo);
+    if !(driver.anchor > new_zone.lo + margin && driver.anchor < new_zone.hi - margin) {
+        let (lo, hi) = driver
+            .state
+            .traction
+            .stick
+            .as_ref()
+            .map_or((new_zone.lo, new_zone.hi), |z| {
+                (z.lo.max(new_zone.lo), z.hi.min(new_zone.hi))
+            });
+        driver.anchor = if hi > lo {
+            0.5 * (lo + hi)
+        } else {
+            new_zone.mid()
+        };
+    }
+    let (d_delta, dissipation) =
+        step_increments(model, &driver.state, &solved.state, driver.anchor);
     driver.displacement += d_delta;
     driver.last_dissipation = dissipation;
     let old = &driver.state;
@@ -527,22 +555,26 @@ fn record(
 /// Increment of the punch displacement and the frictional dissipation between two states.
 ///
 /// The punch moves rigidly, so on the new stick zone `Δux` is uniform and equals `Δδ`; it is
-/// averaged over three points of the stick zone. In a slip zone the slip increment is
+/// taken at the material point `anchor` of the stick zone. The driver keeps one anchor for as
+/// long as it sticks, so that the increments telescope: δ is then `ux(anchor)` of the current
+/// state plus a constant, and a cycle that repeats its states repeats δ exactly (averaging
+/// over points that change from step to step leaves the discretisation error of `ux` to
+/// accumulate as a drift, measured at 2e−6 of the loop's δ range per cycle for the Figure-4
+/// history). In a slip zone the slip increment is
 /// `Δs(x) = ∫ from the stick end to x of Δε` (Δε the change of the surface strain), and the
 /// dissipated energy `−∫ q̄ Δs dx` (q̄ the mean of the two tractions, second order in the step)
 /// is evaluated after an integration by parts as `∓∫ Δε(t) T(t) dt`, with T the integral of q̄
 /// from t to the contact end, so that Δε is needed only at the quadrature nodes.
-pub fn step_increments(model: &ContactModel, old: &ContactState, new: &ContactState) -> (f64, f64) {
+pub fn step_increments(
+    model: &ContactModel,
+    old: &ContactState,
+    new: &ContactState,
+    anchor: f64,
+) -> (f64, f64) {
     let Some(stick) = new.traction.stick.as_ref() else {
         return (0.0, 0.0);
     };
-    let (mid, half) = (stick.mid(), stick.half());
-    let d_ux = |x: f64| new.surface_displacement(model, x) - old.surface_displacement(model, x);
-    let d_delta = [-0.5, 0.0, 0.5]
-        .iter()
-        .map(|f| d_ux(mid + f * half))
-        .sum::<f64>()
-        / 3.0;
+    let d_delta = new.surface_displacement(model, anchor) - old.surface_displacement(model, anchor);
     let q_mean = |x: f64| 0.5 * (old.traction_at(x) + new.traction_at(x));
     let d_strain = |x: f64| new.strain_at(model, x) - old.strain_at(model, x);
     let left_end = (old.centre - old.half_width).min(new.centre - new.half_width);

@@ -118,6 +118,21 @@ impl Memory {
         }
     }
 
+    /// The stored end-of-phase states (turning points) whose tangential load is within `tol`
+    /// of `load`, each once.
+    pub fn states_at_load(&self, load: f64, tol: f64) -> Vec<Arc<ContactState>> {
+        let mut found: Vec<Arc<ContactState>> = Vec::new();
+        for p in &self.pieces {
+            if let StrainSource::State { state } = p.source.as_ref()
+                && (state.tangential_load - load).abs() <= tol
+                && !found.iter().any(|f| Arc::ptr_eq(f, state))
+            {
+                found.push(state.clone());
+            }
+        }
+        found
+    }
+
     /// The interior breakpoints (old stick/slip boundaries), for output.
     pub fn breakpoints(&self) -> Vec<f64> {
         self.pieces.iter().skip(1).map(|p| p.lo).collect()

@@ -317,15 +317,35 @@ impl Inherited {
     /// Breakpoints of the quadrature over the earlier zone.
     fn pieces(&self) -> Vec<f64> {
         let mut pts = vec![self.zone.lo];
+        // Singular points of q̃_E inside the earlier zone: the ends of the zones in its chain
+        // (square roots), their ramps, and centre kinks (see `kink_density`).
+        let kink = |z: &StickZone| (z.kink.abs() > 0.0).then_some(z.mid());
+        let mut inner: Vec<f64> = kink(&self.zone).into_iter().collect();
+        let mut link = self.zone.inherited.clone();
+        while let Some(i) = link {
+            inner.extend([i.zone.lo, i.zone.hi]);
+            inner.extend(kink(&i.zone));
+            inner.extend(
+                i.ramp_lo
+                    .into_iter()
+                    .chain(i.ramp_hi)
+                    .flat_map(|r| [r.0, r.1]),
+            );
+            link = i.zone.inherited.clone();
+        }
         for r in [self.ramp_lo, self.ramp_hi].into_iter().flatten() {
-            for v in [r.0, r.1] {
-                if v > self.zone.lo && v < self.zone.hi {
-                    pts.push(v);
-                }
+            inner.extend([r.0, r.1]);
+        }
+        let (lo, hi) = (self.zone.lo, self.zone.hi);
+        let gap = 1e-9 * (hi - lo);
+        for v in inner {
+            if v > lo + gap && v < hi - gap {
+                pts.push(v);
             }
         }
         pts.push(self.zone.hi);
         pts.sort_by(f64::total_cmp);
+        pts.dedup_by(|x, y| (*x - *y).abs() <= gap);
         pts
     }
 

@@ -48,18 +48,17 @@
 //! - Stick ends can jump when the load passes an earlier turning point (Masing memory) or when
 //!   a plateau of the traction reaches the friction limit: the earlier stick/slip boundaries of
 //!   the memory are tried as starting points.
-//! - Known limitation: in coupled contacts the memory can leave a plateau of
-//!   `q ≈ −0.93 ηp` inside the stick zone during reverse slip, ending in a cusp at an earlier
-//!   stick/slip boundary. At the −½ηP arrival of the PZT-4 default history (M = 64) both
-//!   stick ends reach earlier boundaries; on one side of each the residuals are nearly flat in
-//!   the ends, across it they jump by about 2e−4 (the inherited correction switches between
-//!   whole and faded), so there is no root and the iteration stalls at 3e−6–4e−6. The
-//!   remembered-boundary guesses then find a jump to an earlier zone, whose landing point
-//!   depends on the load step and on M (aluminium, Figure-4 case: lo = −0.18a with 5 steps
-//!   per half-cycle and −0.63a with 10; PZT-4: a jump at M = 32 and 64, none at M = 48 and
-//!   96, where the −½ηP zone is close to the mirror image of the +½ηP zone; see
-//!   `docs/performance.md`). A representation that is continuous across earlier boundaries
-//!   (or a state whose end is pinned at one) is needed.
+//! - Masing's memory: when the load returns to the load of a remembered turning point whose
+//!   stick zone lies inside the current one, the turning state solves the step again, and the
+//!   stretch between the current stick ends and the remembered ones is exactly at the friction
+//!   limit. The residuals are flat in the stick ends over that stretch (measured at the −½ηP
+//!   arrivals of the PZT-4 default history: `|q|/(ηp) − 1` within ±5.5e−4 at M = 48 and ±8e−7
+//!   at M = 96 over 0.27a when the stretch is labelled stuck), so the continuation from the
+//!   previous step lands on an M-dependent point of it or stalls. The turning state is tried
+//!   first (`masing_return`): the canonical stick zone is the smallest, the points at the
+//!   limit being reported as slipping. In coupled contacts the reverse slip zones reach into
+//!   the previous stick zone, so the steady ±Qmax states keep the memory of the first loading
+//!   and are not mirror images of each other (they are for β = 0).
 //!
 //! # Checks
 //! `p ≥ 0`; `|q| ≤ ηp` on the stick zone; and in each slip zone the slip increment since the
@@ -560,9 +559,24 @@ pub fn solve_slip(
             }
         }
     }
+    let mut first_failure = None;
+    if let Some(outcome) = masing_return(
+        model,
+        disc,
+        memory,
+        base,
+        start,
+        tangential_load,
+        sign,
+        options,
+    ) {
+        match outcome {
+            Ok(step) => return Ok(step),
+            Err(e) => first_failure = Some(e),
+        }
+    }
     // Every attempt is made with the fast quasi-Newton iteration first; the jumps above are
     // where it can miss a root that Newton's method finds, so Newton's method is the fallback.
-    let mut first_failure = None;
     for newton in [false, true] {
         for &(signs, guess) in &plan {
             let problem = StepProblem {
@@ -579,7 +593,7 @@ pub fn solve_slip(
             } else {
                 Method::Broyden(warm.filter(|w| w.signs == signs).map(|w| w.jacobian))
             };
-            let res = solve_geometry(&problem, start, guess, method, options);
+            let res = solve_geometry(&problem, start, start, guess, method, options);
             match res {
                 Ok(step) => return Ok(step),
                 Err(e) => {
@@ -589,6 +603,67 @@ pub fn solve_slip(
         }
     }
     Err(first_failure.expect("at least one attempt"))
+}
+
+/// Masing's memory: when the load returns to the load of a remembered turning point whose
+/// stick zone lies inside the current one, that turning state solves the step again (inside
+/// its zone the memory is the one it stuck with, and outside it the step slips as it did).
+/// The stretch between the current stick ends and the remembered ones is then exactly at the
+/// friction limit, so the residuals are flat in the stick ends there: the continuation from
+/// the previous step lands on an M-dependent point of that stretch (the same p, q and g, with
+/// the stretch labelled stuck) or does not converge. The turning state is therefore tried
+/// first, from its own geometry; the smallest stick zone is the canonical one. `None` when no
+/// remembered turning point applies, else the outcome of the last attempt.
+#[allow(clippy::too_many_arguments)]
+fn masing_return(
+    model: &ContactModel,
+    disc: &Discretisation,
+    memory: &Memory,
+    base: Option<&Arc<StickZone>>,
+    start: &ContactState,
+    tangential_load: f64,
+    sign: f64,
+    options: SlipOptions,
+) -> Option<Result<SlipStep, SolveFailure>> {
+    let (lo0, hi0) = start
+        .traction
+        .stick
+        .as_ref()
+        .map_or((f64::NEG_INFINITY, f64::INFINITY), |z| (z.lo, z.hi));
+    let limit = model.friction * start.normal_load;
+    let mut outcome = None;
+    for turning in memory.states_at_load(tangential_load, 1e-9 * limit) {
+        let Some(zone) = turning.traction.stick.as_ref() else {
+            continue;
+        };
+        let signs = (turning.traction.left_sign, turning.traction.right_sign);
+        if signs != (sign, sign) || zone.lo < lo0 || zone.hi > hi0 {
+            continue;
+        }
+        let problem = StepProblem {
+            model,
+            disc,
+            memory,
+            base,
+            signs,
+            normal_load: start.normal_load,
+            tangential_load,
+        };
+        let method = Method::Broyden(None);
+        let result = solve_geometry(
+            &problem,
+            start,
+            &turning,
+            (zone.lo, zone.hi),
+            method,
+            options,
+        );
+        if result.is_ok() {
+            return Some(result);
+        }
+        outcome = Some(result);
+    }
+    outcome
 }
 
 /// Finite-difference Jacobian of the residuals at `g` (the inherited correction of the base
@@ -652,11 +727,14 @@ enum Method {
 /// Newton's method on the geometry with Broyden's rank-one updates: the Jacobian is taken
 /// from `hint` (the previous step's, when the sign pattern is the same) or by finite
 /// differences, updated after every accepted step, and recomputed by finite differences
-/// only when a quasi-Newton direction fails the line search.
-#[allow(clippy::needless_range_loop)]
+/// only when a quasi-Newton direction fails the line search. The iteration begins with the
+/// stick ends `guess` and the half-width, centre and traction of `from`; `start` is the
+/// previous step, against which the slip direction is checked.
+#[allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 fn solve_geometry(
     problem: &StepProblem<'_>,
     start: &ContactState,
+    from: &ContactState,
     guess: (f64, f64),
     method: Method,
     options: SlipOptions,
@@ -666,7 +744,7 @@ fn solve_geometry(
         Method::Newton => (None, false),
     };
     let model = problem.model;
-    let (a0, c0) = (start.half_width, start.centre);
+    let (a0, c0) = (from.half_width, from.centre);
     let clamp_lo = |lo: f64| lo.max(c0 - a0 * (1.0 - 1e-9));
     let clamp_hi = |hi: f64| hi.min(c0 + a0 * (1.0 - 1e-9));
     let mut g = Geometry {
@@ -679,7 +757,7 @@ fn solve_geometry(
         g.lo = c0 - 0.5 * a0;
         g.hi = c0 + 0.5 * a0;
     }
-    let (mut r, mut state) = problem.evaluate(&g, start)?;
+    let (mut r, mut state) = problem.evaluate(&g, from)?;
     let mut evaluations = 1;
     let mut jac = hint;
     let mut fresh = false;

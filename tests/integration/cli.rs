@@ -483,9 +483,11 @@ fn scenario_cattaneo_mindlin_uncoupled() {
         regimes(&s),
         ["forward_slip", "reverse_slip", "forward_slip"]
     );
+    // Cattaneo–Mindlin at the first 0.6; on the return to 0.6 the state is the first 0.6
+    // state again (Masing), stick zone included.
     let ratio = |k: usize| s.snapshots[k].stick_hi / s.snapshots[k].half_width;
     assert!((ratio(0) - 0.4f64.sqrt()).abs() < 1e-9, "{}", ratio(0));
-    assert!((ratio(2) - 0.8f64.sqrt()).abs() < 1e-9, "{}", ratio(2));
+    assert!((ratio(2) - 0.4f64.sqrt()).abs() < 1e-9, "{}", ratio(2));
     let dq = traction_difference(&out, 1.0, 3.0);
     assert!(dq < 1e-8, "{dq:e}");
 }

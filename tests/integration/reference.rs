@@ -453,8 +453,10 @@ fn reference_cattaneo_mindlin_deresiewicz_masing() {
                 ),
                 // Reloading from 0.2: the unloaded state plus twice the loading solution for half
                 // the increment; at 0.6 it meets the first loading curve, which then resumes
-                // (Masing memory).
-                2 => (
+                // (Masing memory). At 0.6 itself the state is the first 0.6 state: the annulus
+                // between its stick zone and the reloading one is exactly at the friction
+                // limit, and the driver reports it as slipping (the remembered turning state).
+                2 if rec.q < 0.6 * lim * (1.0 - 1e-12) => (
                     a * exact.unloading_stick_ratio(0.2 * lim, rec.q),
                     Box::new(move |x| {
                         exact.unloading_traction(0.6 * lim, 0.2 * lim, x)
