@@ -75,7 +75,7 @@ use crate::quadrature::{BoundedSeries, UnboundedSeries};
 use super::memory::Memory;
 use super::normal::arcsine_moment;
 use super::pressure::{Discretisation, electric_resultants};
-use super::{ContactModel, ContactState, Inherited, StickZone, graded_rule};
+use super::{ContactModel, ContactState, Inherited, StickZone};
 
 /// Options of a tangential step.
 #[derive(Debug, Clone, Copy, Serialize)]
@@ -113,6 +113,9 @@ pub struct StepAdmissibility {
     pub slip_reversal: f64,
     /// `min p/p0`.
     pub min_pressure: f64,
+    /// Where each measure is worst (m): stick excess, slip reversal, pressure.
+    #[serde(skip)]
+    pub worst_at: [f64; 3],
 }
 
 /// A solved step.
@@ -780,7 +783,7 @@ fn solve_geometry(
             // memory): tabulate its shape quadrature once.
             state.tabulate_shape();
             let admissibility = assess_step(model, start, &state);
-            check(&admissibility, &state, options.admissibility)?;
+            check(&admissibility, options.admissibility)?;
             return Ok(SlipStep {
                 state,
                 iterations: iter,
@@ -860,23 +863,29 @@ fn solve_geometry(
     })
 }
 
-fn check(adm: &StepAdmissibility, state: &ContactState, tol: f64) -> Result<(), SolveFailure> {
-    let stick = state.traction.stick.as_ref().expect("slip state");
+fn check(adm: &StepAdmissibility, tol: f64) -> Result<(), SolveFailure> {
+    let [stick_at, slip_at, pressure_at] = adm.worst_at;
     super::first_violation(&[
-        ("p ≥ 0", -adm.min_pressure, tol, adm.min_pressure, f64::NAN),
+        (
+            "p ≥ 0",
+            -adm.min_pressure,
+            tol,
+            adm.min_pressure,
+            pressure_at,
+        ),
         (
             "|q| ≤ η p in the stick zone",
             adm.stick_excess,
             tol,
             adm.stick_excess,
-            stick.mid(),
+            stick_at,
         ),
         (
             "slip in the slip zones must oppose the friction",
             adm.slip_reversal,
             tol.max(1e-2),
             adm.slip_reversal,
-            f64::NAN,
+            slip_at,
         ),
     ])
 }
@@ -895,43 +904,85 @@ pub fn assess_step(
         stick_excess: f64::NEG_INFINITY,
         slip_reversal: f64::NEG_INFINITY,
         min_pressure: 1.0,
+        worst_at: [f64::NAN; 3],
     };
     for i in 1..400 {
         let x = c + a * (-1.0 + 2.0 * i as f64 / 400.0);
-        out.min_pressure = out.min_pressure.min(new.pressure_at(x) / p0);
+        let ratio = new.pressure_at(x) / p0;
+        if ratio < out.min_pressure {
+            out.min_pressure = ratio;
+            out.worst_at[2] = x;
+        }
     }
     for i in 0..=200 {
         let x = stick.lo + (stick.hi - stick.lo) * i as f64 / 200.0;
         let excess = (new.traction_at(x).abs() - eta * new.pressure_at(x)) / (eta * p0);
-        out.stick_excess = out.stick_excess.max(excess);
+        if excess > out.stick_excess {
+            out.stick_excess = excess;
+            out.worst_at[0] = x;
+        }
     }
-    // Slip increments at points of each slip zone, by graded quadrature from the stick end.
-    let (nodes, weights) = graded_rule();
+    // Slip increments at points of each slip zone: the running integral of the strain change
+    // from the stick end, by graded quadrature split at every point where either state is not
+    // smooth (stick ends, inherited ends and the old contact ends), up to the inner of the
+    // two contact ends (points that enter or leave the contact have no slip increment).
     let d_strain = |s: f64| new.strain_at(model, s) - old.strain_at(model, s);
+    let mut breaks = new.traction_breakpoints();
+    breaks.extend(old.traction_breakpoints());
+    breaks.extend([old.centre - old.half_width, old.centre + old.half_width]);
     let mut slips = Vec::new();
     let zones = [
-        (stick.hi, c + a, new.traction.right_sign),
-        (stick.lo, c - a, new.traction.left_sign),
+        (
+            stick.hi,
+            (c + a).min(old.centre + old.half_width),
+            new.traction.right_sign,
+        ),
+        (
+            stick.lo,
+            (c - a).max(old.centre - old.half_width),
+            new.traction.left_sign,
+        ),
     ];
     for (from, to, zone_sign) in zones {
-        for f in [0.25, 0.5, 0.75, 1.0] {
-            let x = from + f * (to - from);
-            let (mid, half) = (0.5 * (from + x), 0.5 * (x - from));
-            let slip: f64 = nodes
+        let samples: Vec<f64> = [0.25, 0.5, 0.75, 1.0]
+            .iter()
+            .map(|f| from + f * (to - from))
+            .collect();
+        let (left, right) = (from.min(to), from.max(to));
+        let mut pts: Vec<f64> = breaks
+            .iter()
+            .copied()
+            .filter(|x| *x > left && *x < right)
+            .collect();
+        pts.extend(&samples);
+        pts.extend([left, right]);
+        let table = super::graded_cumulative(pts, &d_strain);
+        for x in samples {
+            // ∫ from `left` to x: the nodes of the pieces before x (x is a piece end).
+            let before: f64 = table
+                .nodes
                 .iter()
-                .zip(weights)
-                .map(|(u, w)| w * half * d_strain(mid + half * u))
+                .filter(|n| n.0 < x)
+                .map(|n| n.1 * n.2)
                 .sum();
-            slips.push((zone_sign, slip));
+            let slip = if to > from {
+                before
+            } else {
+                before - table.total
+            };
+            slips.push((x, zone_sign, slip));
         }
     }
     let largest = slips
         .iter()
-        .fold(0.0f64, |m, (_, s)| m.max(s.abs()))
+        .fold(0.0f64, |m, (_, _, s)| m.max(s.abs()))
         .max(1e-300);
-    out.slip_reversal = slips
-        .iter()
-        .map(|(zs, s)| zs * s / largest)
-        .fold(f64::NEG_INFINITY, f64::max);
+    for (x, zs, s) in slips {
+        let reversal = zs * s / largest;
+        if reversal > out.slip_reversal {
+            out.slip_reversal = reversal;
+            out.worst_at[1] = x;
+        }
+    }
     out
 }
