@@ -377,6 +377,25 @@ pub fn run_partial(
             }
         }
     }
+    let solver_tolerance = SlipOptions::default().tolerance;
+    let stalled: Vec<&crate::history::StepRecord> = records
+        .iter()
+        .filter(|r| r.residual >= solver_tolerance)
+        .collect();
+    if let Some(worst) = stalled
+        .iter()
+        .max_by(|x, y| x.residual.total_cmp(&y.residual))
+    {
+        warnings.push(format!(
+            "{} step(s) accepted with a stalled residual above the solver tolerance {solver_tolerance:e} \
+             (largest {:.3e} at step {}, t = {} s): the iteration stopped improving below the \
+             stall tolerance; see the residual column of steps.csv",
+            stalled.len(),
+            worst.residual,
+            worst.step,
+            worst.t
+        ));
+    }
     let limit = model.friction * scenario.normal_load;
     let tolerance = scenario.raw.numerics.cycle_tolerance;
     let (cycles, verdict) = analyse_cycles(&records, tolerance);
