@@ -578,32 +578,23 @@ pub fn solve_slip(
         }
     }
     let mut attempts = Attempts::default();
-    if let Some(step) = masing_return(
+    let problem_for = |signs: (f64, f64)| StepProblem {
         model,
         disc,
         memory,
         base,
-        start,
+        signs,
+        normal_load: start.normal_load,
         tangential_load,
-        sign,
-        options,
-        &mut attempts,
-    ) {
+    };
+    if let Some(step) = masing_return(&problem_for, start, sign, options, &mut attempts) {
         return Ok(step);
     }
     // Every attempt is made with the fast quasi-Newton iteration first; the jumps above are
     // where it can miss a root that Newton's method finds, so Newton's method is the fallback.
     for newton in [false, true] {
         for &(signs, guess) in &plan {
-            let problem = StepProblem {
-                model,
-                disc,
-                memory,
-                base,
-                signs,
-                normal_load: start.normal_load,
-                tangential_load,
-            };
+            let problem = problem_for(signs);
             let method = if newton {
                 Method::Newton
             } else {
@@ -631,14 +622,9 @@ pub fn solve_slip(
 /// the stretch labelled stuck) or does not converge. The turning state is therefore tried
 /// first, from its own geometry; the smallest stick zone is the canonical one. `None` when no
 /// remembered turning point applies or none converges (failures go to `attempts`).
-#[allow(clippy::too_many_arguments)]
-fn masing_return(
-    model: &ContactModel,
-    disc: &Discretisation,
-    memory: &Memory,
-    base: Option<&Arc<StickZone>>,
+fn masing_return<'a>(
+    problem_for: &dyn Fn((f64, f64)) -> StepProblem<'a>,
     start: &ContactState,
-    tangential_load: f64,
     sign: f64,
     options: SlipOptions,
     attempts: &mut Attempts,
@@ -648,8 +634,12 @@ fn masing_return(
         .stick
         .as_ref()
         .map_or((f64::NEG_INFINITY, f64::INFINITY), |z| (z.lo, z.hi));
-    let limit = model.friction * start.normal_load;
-    for turning in memory.states_at_load(tangential_load, 1e-9 * limit) {
+    let probe = problem_for((sign, sign));
+    let limit = probe.model.friction * start.normal_load;
+    for turning in probe
+        .memory
+        .states_at_load(probe.tangential_load, 1e-9 * limit)
+    {
         let Some(zone) = turning.traction.stick.as_ref() else {
             continue;
         };
@@ -657,18 +647,9 @@ fn masing_return(
         if signs != (sign, sign) || zone.lo < lo0 || zone.hi > hi0 {
             continue;
         }
-        let problem = StepProblem {
-            model,
-            disc,
-            memory,
-            base,
-            signs,
-            normal_load: start.normal_load,
-            tangential_load,
-        };
         let method = Method::Broyden(None);
         let guess = (zone.lo, zone.hi);
-        match solve_geometry(&problem, start, &turning, guess, method, options) {
+        match solve_geometry(&probe, start, &turning, guess, method, options) {
             Ok(step) => return Some(step),
             Err(failed) => attempts.record(failed),
         }
