@@ -301,6 +301,14 @@ impl Inherited {
         up * down
     }
 
+    /// The start and end points of the fade ramps.
+    fn ramp_points(&self) -> impl Iterator<Item = f64> + use<> {
+        [self.ramp_lo, self.ramp_hi]
+            .into_iter()
+            .flatten()
+            .flat_map(|r| [r.0, r.1])
+    }
+
     fn faded(&self) -> bool {
         self.ramp_lo.is_some() || self.ramp_hi.is_some()
     }
@@ -319,23 +327,13 @@ impl Inherited {
         let mut pts = vec![self.zone.lo];
         // Singular points of q̃_E inside the earlier zone: the ends of the zones in its chain
         // (square roots), their ramps, and centre kinks (see `kink_density`).
-        let kink = |z: &StickZone| (z.kink.abs() > 0.0).then_some(z.mid());
-        let mut inner: Vec<f64> = kink(&self.zone).into_iter().collect();
-        let mut link = self.zone.inherited.clone();
-        while let Some(i) = link {
+        let mut inner: Vec<f64> = self.zone.kink_point().into_iter().collect();
+        for i in self.zone.links() {
             inner.extend([i.zone.lo, i.zone.hi]);
-            inner.extend(kink(&i.zone));
-            inner.extend(
-                i.ramp_lo
-                    .into_iter()
-                    .chain(i.ramp_hi)
-                    .flat_map(|r| [r.0, r.1]),
-            );
-            link = i.zone.inherited.clone();
+            inner.extend(i.zone.kink_point());
+            inner.extend(i.ramp_points());
         }
-        for r in [self.ramp_lo, self.ramp_hi].into_iter().flatten() {
-            inner.extend([r.0, r.1]);
-        }
+        inner.extend(self.ramp_points());
         let (lo, hi) = (self.zone.lo, self.zone.hi);
         let gap = 1e-9 * (hi - lo);
         for v in inner {
@@ -370,7 +368,8 @@ impl Inherited {
         if !self.faded() {
             return self.zone.correction_integral();
         }
-        graded_integral(self.pieces(), &|x| self.value(x))
+        // The fade table holds `w q̃_E` and χ on the same graded nodes.
+        self.table().iter().map(|(_, wq, chi)| wq * chi).sum()
     }
 }
 
@@ -471,7 +470,17 @@ impl StickZone {
 
     /// Number of zones in the chain.
     pub fn chain_len(&self) -> usize {
-        1 + self.inherited.as_ref().map_or(0, |z| z.zone.chain_len())
+        1 + self.links().count()
+    }
+
+    /// The inherited corrections of the chain, outermost first.
+    pub fn links(&self) -> impl Iterator<Item = &Inherited> {
+        std::iter::successors(self.inherited.as_deref(), |i| i.zone.inherited.as_deref())
+    }
+
+    /// The zone's centre when it carries a centre kink (see [`kink_density`]).
+    fn kink_point(&self) -> Option<f64> {
+        (self.kink.abs() > 0.0).then_some(self.mid())
     }
 }
 
@@ -897,20 +906,13 @@ impl ContactState {
     /// Where the traction is not smooth: the stick ends and the ends (and fade ramps) of the
     /// inherited corrections.
     pub fn traction_breakpoints(&self) -> Vec<f64> {
-        let mut pts = Vec::new();
-        let mut zone = self
-            .traction
-            .stick
-            .as_ref()
-            .map(|z| (z.lo, z.hi, z.inherited.clone()));
-        while let Some((lo, hi, inherited)) = zone {
-            pts.extend([lo, hi]);
-            zone = inherited.map(|i| {
-                for r in [i.ramp_lo, i.ramp_hi].into_iter().flatten() {
-                    pts.extend([r.0, r.1]);
-                }
-                (i.zone.lo, i.zone.hi, i.zone.inherited.clone())
-            });
+        let Some(stick) = self.traction.stick.as_ref() else {
+            return Vec::new();
+        };
+        let mut pts = vec![stick.lo, stick.hi];
+        for i in stick.links() {
+            pts.extend(i.ramp_points());
+            pts.extend([i.zone.lo, i.zone.hi]);
         }
         pts
     }
@@ -934,10 +936,5 @@ impl ContactState {
                     / std::f64::consts::PI
         };
         self.contact_integral(Some(x), &integrand) + x * x / (2.0 * model.radius)
-    }
-
-    /// `∫ q f dx` over the contact (pieces split at the stick ends).
-    pub fn traction_moment(&self, f: &dyn Fn(f64) -> f64) -> f64 {
-        self.contact_integral(None, &|s| self.traction_at(s) * f(s))
     }
 }

@@ -42,6 +42,28 @@ fn uncoupled() -> Uncoupled {
     }
 }
 
+/// The paper's baseline (the built-in default scenario: PZT-4, conducting punch) after normal
+/// loading with M nodes, and its friction limit ηP.
+struct Baseline {
+    model: ContactModel,
+    lim: f64,
+    disc: Discretisation,
+    normal: fretsim::contact::normal::NormalLoading,
+}
+
+fn baseline(m: usize) -> Baseline {
+    use fretsim::contact::normal::{NormalOptions, solve_normal};
+    let sc = fretsim::scenario::default_scenario();
+    let disc = Discretisation::new(m);
+    let normal = solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
+    Baseline {
+        lim: sc.model.friction * sc.normal_load,
+        model: sc.model,
+        disc,
+        normal,
+    }
+}
+
 /// The step records of a load history (points `(t, Q)`) run from the end of normal loading.
 fn step_records(
     model: &ContactModel,
@@ -728,12 +750,12 @@ fn cycle_verdicts() {
 /// δ to 1.8e−12 and the dissipation to 6e−13 of their largest values (round-off).
 #[test]
 fn history_is_mirror_symmetric() {
-    use fretsim::contact::normal::{NormalOptions, solve_normal};
-    let sc = fretsim::scenario::default_scenario();
-    let (model, p) = (&sc.model, sc.normal_load);
-    let lim = model.friction * p;
-    let disc = Discretisation::new(64);
-    let normal = solve_normal(model, &disc, p, NormalOptions::default()).unwrap();
+    let Baseline {
+        model,
+        lim,
+        disc,
+        normal,
+    } = baseline(64);
     let run = |s: f64| {
         let points = vec![
             (0.0, 0.0),
@@ -741,7 +763,7 @@ fn history_is_mirror_symmetric() {
             (3.0, -0.5 * s * lim),
             (5.0, 0.5 * s * lim),
         ];
-        step_records(model, &disc, &normal, points, 10, 0.05 * lim)
+        step_records(&model, &disc, &normal, points, 10, 0.05 * lim)
     };
     let (plus, minus) = (run(1.0), run(-1.0));
     assert_eq!(plus.len(), 51, "{}", plus.len());
@@ -827,11 +849,9 @@ fn assert_zones_inside_and_monotone(recs: &[fretsim::history::StepRecord], a: f6
 ///   6e−14 of its range (round-off).
 #[test]
 fn coupled_cycle_masing_return_and_step_refinement() {
-    use fretsim::contact::normal::{NormalOptions, solve_normal};
     use fretsim::history::StepRecord;
-    let sc = fretsim::scenario::default_scenario();
-    let (model, p) = (&sc.model, sc.normal_load);
-    let lim = model.friction * p;
+    let runs = [baseline(48), baseline(64)];
+    let lim = runs[0].lim;
     let points = vec![
         (0.0, 0.0),
         (1.0, 0.5 * lim),
@@ -846,11 +866,10 @@ fn coupled_cycle_masing_return_and_step_refinement() {
             .collect()
     };
     let mut by_m = Vec::new();
-    for m in [48, 64] {
-        let disc = Discretisation::new(m);
-        let normal = solve_normal(model, &disc, p, NormalOptions::default()).unwrap();
-        let a = normal.state.half_width;
-        let recs = step_records(model, &disc, &normal, points.clone(), 10, 0.05 * lim);
+    for b in &runs {
+        let m = b.disc.nodes();
+        let a = b.normal.state.half_width;
+        let recs = step_records(&b.model, &b.disc, &b.normal, points.clone(), 10, 0.05 * lim);
         assert_eq!(recs.len(), 71);
         assert_zones_inside_and_monotone(&recs, a);
         let t = turning(&recs);
@@ -881,9 +900,8 @@ fn coupled_cycle_masing_return_and_step_refinement() {
         }
     }
     // Step refinement at M = 64.
-    let disc = Discretisation::new(64);
-    let normal = solve_normal(model, &disc, p, NormalOptions::default()).unwrap();
-    let fine = step_records(model, &disc, &normal, points, 10, 0.025 * lim);
+    let b = &runs[1];
+    let fine = step_records(&b.model, &b.disc, &b.normal, points, 10, 0.025 * lim);
     assert_eq!(fine.len(), 141);
     let (tf, tc) = (turning(&fine), turning(recs64));
     let range = tc[0].displacement - tc[1].displacement;
@@ -913,13 +931,13 @@ fn coupled_cycle_masing_return_and_step_refinement() {
 /// (round-off).
 #[test]
 fn coupled_partial_unload_reload_follows_masing() {
-    use fretsim::contact::normal::{NormalOptions, solve_normal};
     use fretsim::history::StepRecord;
-    let sc = fretsim::scenario::default_scenario();
-    let (model, p) = (&sc.model, sc.normal_load);
-    let lim = model.friction * p;
-    let disc = Discretisation::new(64);
-    let normal = solve_normal(model, &disc, p, NormalOptions::default()).unwrap();
+    let Baseline {
+        model,
+        lim,
+        disc,
+        normal,
+    } = baseline(64);
     let a = normal.state.half_width;
     let path = |loads: &[f64]| {
         let points = loads
@@ -927,7 +945,7 @@ fn coupled_partial_unload_reload_follows_masing() {
             .enumerate()
             .map(|(i, f)| (i as f64, f * lim))
             .collect();
-        step_records(model, &disc, &normal, points, 5, 0.1 * lim)
+        step_records(&model, &disc, &normal, points, 5, 0.1 * lim)
     };
     let cycled = path(&[0.0, 0.5, 0.1, 0.5, 0.7]);
     let monotonic = path(&[0.0, 0.7]);
