@@ -113,6 +113,8 @@ fn stick_for(
     let eta = model.friction;
     let mut state = trial.clone();
     state.traction.stick = Some(StickZone::new(-b, b, BoundedSeries::default(), 0.0));
+    // H'(pS) is needed at every collocation point: tabulate its quadrature once.
+    state.tabulate_shape();
     let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
     let local = model.local_pressure_strain(state.split);
     let rhs: Vec<f64> = disc
@@ -255,6 +257,8 @@ fn solve_normal_directed(
             // Final stick solve with the converged pressure.
             let (b_fin, slope_fin, correction, kink) = find_stick_zone(model, disc, &state, b)?;
             state.traction.stick = Some(StickZone::new(-b_fin, b_fin, correction, kink));
+            // The state is evaluated many times from here on (checks, fields, memory).
+            state.tabulate_shape();
             let admissibility = check_normal_state(model, &state, slope_fin, options.admissibility)
                 .map_err(|failure| {
                     if b_fin >= state.half_width {
