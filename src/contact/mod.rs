@@ -698,38 +698,75 @@ pub struct GradedTable {
 /// together with the running integral up to each node, from the cumulative Gauss–Legendre
 /// matrix in the graded variable ([`crate::quadrature::gauss_legendre_cumulative`]). Nested
 /// integrals such as `∫ g(t) ∫_t^R f ds dt` then cost one evaluation of f per node.
-pub fn graded_cumulative(mut points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
-    static CUMULATIVE: std::sync::OnceLock<Vec<f64>> = std::sync::OnceLock::new();
-    let (nodes, weights) = graded_rule();
-    let n = nodes.len();
-    let cumulative = CUMULATIVE.get_or_init(|| {
-        // Row k: ∫_{-1}^{v_k} h(v) dv with h = f(x(v)) x'(v), x'(v) = half (π/2) cos(πv/2).
-        let (v, _) = crate::quadrature::gauss_legendre(n);
+pub fn graded_cumulative(points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
+    static FINE: std::sync::OnceLock<GradedRule> = std::sync::OnceLock::new();
+    FINE.get_or_init(|| GradedRule::new(GRADED_NODES))
+        .cumulative(points, f)
+}
+
+/// As [`graded_cumulative`] with a 32-node rule per piece, for estimates that need a few
+/// digits only (the slip-direction check of a step).
+pub fn graded_cumulative_coarse(points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
+    static COARSE: std::sync::OnceLock<GradedRule> = std::sync::OnceLock::new();
+    COARSE
+        .get_or_init(|| GradedRule::new(32))
+        .cumulative(points, f)
+}
+
+/// Nodes per piece of the graded rule of [`graded_rule`].
+const GRADED_NODES: usize = 96;
+
+/// A sine-graded Gauss–Legendre rule (see [`graded_rule`]) with its cumulative matrix.
+struct GradedRule {
+    nodes: Vec<f64>,
+    weights: Vec<f64>,
+    /// Row k: the weights of `∫_{-1}^{u_k}` in the graded variable, row-major n × n.
+    cumulative: Vec<f64>,
+}
+
+impl GradedRule {
+    fn new(n: usize) -> Self {
+        let (v, w) = crate::quadrature::gauss_legendre(n);
         let s = crate::quadrature::gauss_legendre_cumulative(n);
         let half_pi = std::f64::consts::FRAC_PI_2;
-        (0..n * n)
+        // Row k: ∫_{-1}^{v_k} h(v) dv with h = f(x(v)) x'(v), x'(v) = half (π/2) cos(πv/2).
+        let cumulative = (0..n * n)
             .map(|kj| s[kj] * half_pi * (half_pi * v[kj % n]).cos())
-            .collect()
-    });
-    points.sort_by(f64::total_cmp);
-    points.dedup();
-    let mut table = GradedTable::default();
-    for w in points.windows(2) {
-        let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-        let values: Vec<f64> = nodes.iter().map(|u| f(mid + half * u)).collect();
-        for k in 0..n {
-            let row = &cumulative[k * n..(k + 1) * n];
-            let before: f64 = half * row.iter().zip(&values).map(|(c, v)| c * v).sum::<f64>();
-            table.nodes.push((
-                mid + half * nodes[k],
-                weights[k] * half,
-                values[k],
-                table.total + before,
-            ));
+            .collect();
+        Self {
+            nodes: v.iter().map(|v| (half_pi * v).sin()).collect(),
+            weights: v
+                .iter()
+                .zip(&w)
+                .map(|(v, w)| w * half_pi * (half_pi * v).cos())
+                .collect(),
+            cumulative,
         }
-        table.total += half * weights.iter().zip(&values).map(|(w, v)| w * v).sum::<f64>();
     }
-    table
+
+    fn cumulative(&self, mut points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
+        let (nodes, weights) = (&self.nodes, &self.weights);
+        let n = nodes.len();
+        points.sort_by(f64::total_cmp);
+        points.dedup();
+        let mut table = GradedTable::default();
+        for w in points.windows(2) {
+            let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+            let values: Vec<f64> = nodes.iter().map(|u| f(mid + half * u)).collect();
+            for k in 0..n {
+                let row = &self.cumulative[k * n..(k + 1) * n];
+                let before: f64 = half * row.iter().zip(&values).map(|(c, v)| c * v).sum::<f64>();
+                table.nodes.push((
+                    mid + half * nodes[k],
+                    weights[k] * half,
+                    values[k],
+                    table.total + before,
+                ));
+            }
+            table.total += half * weights.iter().zip(&values).map(|(w, v)| w * v).sum::<f64>();
+        }
+        table
+    }
 }
 
 /// One admissibility check: `(name, measure, allowed, reported value, x)`; it fails when
@@ -753,7 +790,7 @@ pub(crate) fn first_violation(checks: &[Check<'_>]) -> Result<(), crate::error::
 pub fn graded_rule() -> &'static (Vec<f64>, Vec<f64>) {
     static RULE: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
     RULE.get_or_init(|| {
-        let (v, w) = crate::quadrature::gauss_legendre(96);
+        let (v, w) = crate::quadrature::gauss_legendre(GRADED_NODES);
         let half_pi = std::f64::consts::FRAC_PI_2;
         let nodes = v.iter().map(|v| (half_pi * v).sin()).collect();
         let weights = v
