@@ -245,8 +245,19 @@ pub struct Inherited {
     pub ramp_lo: Option<(f64, f64)>,
     /// Right ramp `(start, end)`.
     pub ramp_hi: Option<(f64, f64)>,
-    /// Quadrature table `(t, w q̃_E(t), χ(t))` of the fade integral, built on first use.
-    table: std::sync::OnceLock<Vec<(f64, f64, f64)>>,
+    /// Quadrature table of the fade integral, built on first use.
+    table: std::sync::OnceLock<FadeTable>,
+}
+
+/// Quadrature nodes `(t, w q̃_E(t), χ(t))` of the fade integral of an [`Inherited`], all of
+/// them and, in the same order, those with χ ≠ 1 and those with χ ≠ 0: at a point x where
+/// χ(x) is 1 (or 0) the nodes with the same χ contribute exactly zero to the sum of
+/// [`Inherited::cauchy`] and are skipped.
+#[derive(Debug, Clone, Default)]
+struct FadeTable {
+    all: Vec<(f64, f64, f64)>,
+    not_one: Vec<(f64, f64, f64)>,
+    not_zero: Vec<(f64, f64, f64)>,
 }
 
 impl PartialEq for Inherited {
@@ -275,18 +286,23 @@ impl Inherited {
         }
     }
 
-    fn table(&self) -> &[(f64, f64, f64)] {
+    fn table(&self) -> &FadeTable {
         self.table.get_or_init(|| {
             let (nodes, weights) = graded_rule();
-            let mut out = Vec::new();
+            let mut all = Vec::new();
             for w in self.pieces().windows(2) {
                 let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
                 for (u, wt) in nodes.iter().zip(weights) {
                     let t = mid + half * u;
-                    out.push((t, wt * half * self.zone.correction_at(t), self.chi(t)));
+                    all.push((t, wt * half * self.zone.correction_at(t), self.chi(t)));
                 }
             }
-            out
+            let except = |v: f64| all.iter().copied().filter(|e| e.2 != v).collect();
+            FadeTable {
+                not_one: except(1.0),
+                not_zero: except(0.0),
+                all,
+            }
         })
     }
 
@@ -354,8 +370,15 @@ impl Inherited {
         }
         let cx = self.chi(x);
         let tiny = 1e-14 * (self.zone.hi - self.zone.lo);
-        let sum: f64 = self
-            .table()
+        let table = self.table();
+        let nodes = if cx == 1.0 {
+            &table.not_one
+        } else if cx == 0.0 {
+            &table.not_zero
+        } else {
+            &table.all
+        };
+        let sum: f64 = nodes
             .iter()
             .filter(|(t, _, _)| (t - x).abs() > tiny)
             .map(|(t, wq, chi)| wq * (chi - cx) / (t - x))
@@ -369,7 +392,7 @@ impl Inherited {
             return self.zone.correction_integral();
         }
         // The fade table holds `w q̃_E` and χ on the same graded nodes.
-        self.table().iter().map(|(_, wq, chi)| wq * chi).sum()
+        self.table().all.iter().map(|(_, wq, chi)| wq * chi).sum()
     }
 }
 
