@@ -4,7 +4,11 @@
 //! Everything here lives on the normalised interval [−1, 1] and depends only on the number of
 //! nodes M, so a [`BoundedGrid`] or [`UnboundedGrid`] is built and LU-factored once per run
 //! (faer) and reused by every solve. Geometry enters through the affine map to the physical
-//! interval, which leaves `(1/π)⨍ f(θ)/(θ − τ) dθ` unchanged.
+//! interval, which leaves `(1/π)⨍ f(θ)/(θ − τ) dθ` unchanged. For iterations that solve the
+//! same system many times, each grid also keeps the product of the Chebyshev transform and the
+//! inverse collocation matrix, so that right-hand side → coefficients is one matrix–vector
+//! product (`solve_coefficients`), and the series provide evaluation rows (`density_row`,
+//! `cauchy_row`) to assemble such products at given points.
 //!
 //! # Bounded at both ends (seed eqs. 36–38, 56, 58)
 //! `f(θ) = √(1 − θ²) ψ(θ)`, `ψ = Σ_{n=1}^{M} β_n U_{n−1}`. Nodes `θ_l = cos(lπ/(M+1))`,
@@ -34,8 +38,64 @@
 //! ```
 
 use faer::Mat;
-use faer::linalg::solvers::{PartialPivLu, Solve};
+use faer::linalg::solvers::{DenseSolveCore, PartialPivLu, Solve};
 use std::f64::consts::PI;
+
+/// A dense row-major matrix, for the matrix–vector products repeated by an iteration at fixed
+/// geometry (the products replace per-point Clenshaw sums, which are latency-bound).
+#[derive(Debug, Clone, Default)]
+pub struct RowMatrix {
+    cols: usize,
+    data: Vec<f64>,
+}
+
+impl RowMatrix {
+    /// A `rows × cols` matrix of zeros.
+    pub fn zeros(rows: usize, cols: usize) -> Self {
+        Self {
+            cols,
+            data: vec![0.0; rows * cols],
+        }
+    }
+
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.data.len().checked_div(self.cols).unwrap_or(0)
+    }
+
+    /// Row i.
+    pub fn row(&self, i: usize) -> &[f64] {
+        &self.data[i * self.cols..(i + 1) * self.cols]
+    }
+
+    /// Row i, mutable.
+    pub fn row_mut(&mut self, i: usize) -> &mut [f64] {
+        &mut self.data[i * self.cols..(i + 1) * self.cols]
+    }
+
+    /// `y = A x`.
+    pub fn apply(&self, x: &[f64], y: &mut [f64]) {
+        debug_assert_eq!(x.len(), self.cols);
+        for (i, yi) in y.iter_mut().enumerate() {
+            *yi = dot(self.row(i), x);
+        }
+    }
+}
+
+/// `Σ a_i b_i` with four partial sums (which the compiler can keep in vector registers).
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a4, b4) = (a[..n].chunks_exact(4), b[..n].chunks_exact(4));
+    let (ra, rb) = (a4.remainder(), b4.remainder());
+    let mut acc = [0.0; 4];
+    for (x, y) in a4.zip(b4) {
+        for k in 0..4 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
+    (acc[0] + acc[2]) + (acc[1] + acc[3]) + tail
+}
 
 /// Grid and factored collocation matrix for densities bounded at both ends.
 #[derive(Debug, Clone)]
@@ -48,6 +108,8 @@ pub struct BoundedGrid {
     /// `sin(t_l) sin(n t_l)` table for the U-coefficient transform, row n−1.
     transform: Vec<f64>,
     lu: PartialPivLu<f64>,
+    /// The transform times the inverse collocation matrix: rows 0..M give β, row M gives λ.
+    solution: RowMatrix,
 }
 
 /// Grid and factored collocation matrix for densities unbounded (inverse square root) at both ends.
@@ -61,6 +123,8 @@ pub struct UnboundedGrid {
     /// `T_n(θ_l)` table, row n.
     transform: Vec<f64>,
     lu: PartialPivLu<f64>,
+    /// The transform times the inverse collocation matrix: γ from `(h(τ_r), resultant)`.
+    solution: RowMatrix,
 }
 
 impl BoundedGrid {
@@ -89,12 +153,24 @@ impl BoundedGrid {
                     2.0 / (m as f64 + 1.0) * t.sin() * (n as f64 * t).sin();
             }
         }
+        let inverse = lu.inverse();
+        let mut solution = RowMatrix::zeros(m + 1, m + 1);
+        for n in 0..m {
+            let row = &transform[n * m..(n + 1) * m];
+            for (r, out) in solution.row_mut(n).iter_mut().enumerate() {
+                *out = (0..m).map(|l| row[l] * inverse[(l, r)]).sum();
+            }
+        }
+        for (r, out) in solution.row_mut(m).iter_mut().enumerate() {
+            *out = inverse[(m, r)];
+        }
         Self {
             m,
             nodes,
             collocation,
             transform,
             lu,
+            solution,
         }
     }
 
@@ -129,6 +205,16 @@ impl BoundedGrid {
         PI / (self.m as f64 + 1.0) * s
     }
 
+    /// [`Self::solve`] followed by [`Self::coefficients`] as one product with the
+    /// precomputed matrix: writes β and returns λ.
+    pub fn solve_coefficients(&self, rhs: &[f64], beta: &mut [f64]) -> f64 {
+        debug_assert_eq!(rhs.len(), self.m + 1);
+        for (n, b) in beta.iter_mut().enumerate() {
+            *b = dot(self.solution.row(n), rhs);
+        }
+        dot(self.solution.row(self.m), rhs)
+    }
+
     /// Coefficients β_n, n = 1..M, of `ψ = Σ β_n U_{n−1}` from nodal values (index n−1).
     pub fn coefficients(&self, psi: &[f64], beta: &mut [f64]) {
         for (n, b) in beta.iter_mut().enumerate() {
@@ -161,12 +247,21 @@ impl UnboundedGrid {
                 transform[n * m + l] = scale * (n as f64 * nodes[l].acos()).cos();
             }
         }
+        let inverse = lu.inverse();
+        let mut solution = RowMatrix::zeros(m, m);
+        for n in 0..m {
+            let row = &transform[n * m..(n + 1) * m];
+            for (r, out) in solution.row_mut(n).iter_mut().enumerate() {
+                *out = (0..m).map(|l| row[l] * inverse[(l, r)]).sum();
+            }
+        }
         Self {
             m,
             nodes,
             collocation,
             transform,
             lu,
+            solution,
         }
     }
 
@@ -187,6 +282,16 @@ impl UnboundedGrid {
         theta[..self.m - 1].copy_from_slice(rhs);
         theta[self.m - 1] = resultant;
         self.lu.solve_in_place(faer::ColMut::from_slice_mut(theta));
+    }
+
+    /// [`Self::solve`] followed by [`Self::coefficients`] as one product with the
+    /// precomputed matrix: writes γ.
+    pub fn solve_coefficients(&self, rhs: &[f64], resultant: f64, gamma: &mut [f64]) {
+        debug_assert_eq!(rhs.len(), self.m - 1);
+        for (n, g) in gamma.iter_mut().enumerate() {
+            let row = self.solution.row(n);
+            *g = dot(&row[..self.m - 1], rhs) + row[self.m - 1] * resultant;
+        }
     }
 
     /// Coefficients γ_n, n = 0..M−1, of `ϑ = Σ γ_n T_n` from nodal values.
@@ -271,6 +376,38 @@ impl BoundedSeries {
         PI * self.beta.first().copied().unwrap_or(0.0) / 2.0
     }
 
+    /// The row r with `density(τ) = r · β`: `√(1−τ²) U_{n−1}(τ)`, n = 1..M (zero outside).
+    pub fn density_row(tau: f64, row: &mut [f64]) {
+        if tau.abs() >= 1.0 {
+            row.fill(0.0);
+            return;
+        }
+        let s = (1.0 - tau * tau).sqrt();
+        let (mut u0, mut u1) = (0.0, 1.0);
+        for r in row.iter_mut() {
+            *r = s * u1;
+            (u0, u1) = (u1, 2.0 * tau * u1 - u0);
+        }
+    }
+
+    /// The row r with `cauchy(τ) = r · β`: `−T_n(τ)` inside, `−zⁿ` outside, n = 1..M.
+    pub fn cauchy_row(tau: f64, row: &mut [f64]) {
+        if tau.abs() < 1.0 {
+            let (mut t0, mut t1) = (1.0, tau);
+            for r in row.iter_mut() {
+                *r = -t1;
+                (t0, t1) = (t1, 2.0 * tau * t1 - t0);
+            }
+        } else {
+            let z = exterior(tau);
+            let mut power = z;
+            for r in row.iter_mut() {
+                *r = -power;
+                power *= z;
+            }
+        }
+    }
+
     /// `(1/π)⨍ f(t)/(t − τ) dt` at any τ (inside: −Σ β_n T_n; outside: −Σ β_n zⁿ).
     pub fn cauchy(&self, tau: f64) -> f64 {
         if tau.abs() < 1.0 {
@@ -308,6 +445,20 @@ impl UnboundedSeries {
             0.0
         } else {
             self.theta(tau) / (1.0 - tau * tau).sqrt()
+        }
+    }
+
+    /// The row r with `density(τ) = r · γ`: `T_n(τ)/√(1−τ²)`, n = 0..M−1 (zero outside).
+    pub fn density_row(tau: f64, row: &mut [f64]) {
+        if tau.abs() >= 1.0 {
+            row.fill(0.0);
+            return;
+        }
+        let s = 1.0 / (1.0 - tau * tau).sqrt();
+        let (mut t0, mut t1) = (1.0, tau);
+        for r in row.iter_mut() {
+            *r = s * t0;
+            (t0, t1) = (t1, 2.0 * tau * t1 - t0);
         }
     }
 
@@ -509,6 +660,89 @@ mod tests {
             assert!((one.cauchy(x) - exact).abs() < 1e-14);
         }
         assert!((series.psi(1.0) - (3.0 + 0.5)).abs() < 1e-12, "U_2(1) = 3");
+    }
+
+    #[test]
+    fn precomputed_solutions_match_the_factored_solves() {
+        // h = −T_3 − 0.5 T_1 + 0.25: β = (0.5, 0, 1, 0, …), λ = 0.25 (as above), now by the
+        // single product with the transform times the inverse.
+        let m = 20;
+        let g = BoundedGrid::new(m);
+        let rhs: Vec<f64> = g
+            .collocation
+            .iter()
+            .map(|&x| -t(3, x) - 0.5 * t(1, x) + 0.25)
+            .collect();
+        let mut beta = vec![0.0; m];
+        let lambda = g.solve_coefficients(&rhs, &mut beta);
+        assert!((lambda - 0.25).abs() < 1e-13);
+        for (n, b) in beta.iter().enumerate() {
+            let expected = [0.5, 0.0, 1.0].get(n).copied().unwrap_or(0.0);
+            assert!((b - expected).abs() < 1e-13, "β_{}", n + 1);
+        }
+        // ϑ = 2 + T_2 − 0.5 T_5 from h = U_1 − 0.5 U_4 and resultant 2π.
+        let g = UnboundedGrid::new(16);
+        let rhs: Vec<f64> = g
+            .collocation
+            .iter()
+            .map(|&x| u(1, x) - 0.5 * u(4, x))
+            .collect();
+        let mut gamma = vec![0.0; 16];
+        g.solve_coefficients(&rhs, 2.0 * PI, &mut gamma);
+        for (n, v) in gamma.iter().enumerate() {
+            let expected = [2.0, 0.0, 1.0, 0.0, 0.0, -0.5]
+                .get(n)
+                .copied()
+                .unwrap_or(0.0);
+            assert!((v - expected).abs() < 1e-12, "γ_{n}");
+        }
+    }
+
+    #[test]
+    fn evaluation_rows_match_the_series() {
+        // Rows dotted with the coefficients against the closed forms of the series, inside and
+        // outside the interval (and the Clenshaw sums they replace).
+        let bounded = BoundedSeries {
+            beta: (1..=12).map(|n| 1.0 / (n * n) as f64).collect(),
+        };
+        let unbounded = UnboundedSeries {
+            gamma: (0..12).map(|n| (-0.7f64).powi(n)).collect(),
+        };
+        let mut row = vec![0.0; 12];
+        for &tau in &[-1.7, -0.999, -0.3, 0.0, 0.41, 0.95, 1.0, 2.5] {
+            BoundedSeries::density_row(tau, &mut row);
+            let density: f64 = if f64::abs(tau) < 1.0 {
+                let s = (1.0 - tau * tau).sqrt();
+                (1..=12).map(|n| s * u(n - 1, tau) / (n * n) as f64).sum()
+            } else {
+                0.0
+            };
+            assert!(
+                (dot(&row, &bounded.beta) - density).abs() < 1e-14,
+                "density at {tau}"
+            );
+            assert!((dot(&row, &bounded.beta) - bounded.density(tau)).abs() < 1e-14);
+            BoundedSeries::cauchy_row(tau, &mut row);
+            assert!(
+                (dot(&row, &bounded.beta) - bounded.cauchy(tau)).abs() < 1e-14,
+                "Cauchy at {tau}"
+            );
+            if f64::abs(tau) < 1.0 {
+                let inside: f64 = (1..=12).map(|n| -t(n, tau) / (n * n) as f64).sum();
+                assert!((dot(&row, &bounded.beta) - inside).abs() < 1e-14);
+            }
+            UnboundedSeries::density_row(tau, &mut row);
+            let theta: f64 = (0..12).map(|n| (-0.7f64).powi(n as i32) * t(n, tau)).sum();
+            let expected = if f64::abs(tau) < 1.0 {
+                theta / (1.0 - tau * tau).sqrt()
+            } else {
+                0.0
+            };
+            assert!(
+                (dot(&row, &unbounded.gamma) - expected).abs() < 1e-12 * expected.abs().max(1.0),
+                "charge density at {tau}"
+            );
+        }
     }
 
     #[test]

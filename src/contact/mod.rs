@@ -297,7 +297,12 @@ impl Inherited {
                     all.push((t, wt * half * self.zone.correction_at(t), self.chi(t)));
                 }
             }
-            let except = |v: f64| all.iter().copied().filter(|e| e.2 != v).collect();
+            let except = |v: f64| {
+                all.iter()
+                    .copied()
+                    .filter(|e| (e.2 - v).abs() > 0.0)
+                    .collect()
+            };
             FadeTable {
                 not_one: except(1.0),
                 not_zero: except(0.0),
@@ -371,9 +376,10 @@ impl Inherited {
         let cx = self.chi(x);
         let tiny = 1e-14 * (self.zone.hi - self.zone.lo);
         let table = self.table();
-        let nodes = if cx == 1.0 {
+        // χ is exactly 1 (or 0) away from the ramps; only exact zeros are skipped.
+        let nodes = if (cx - 1.0).abs() <= 0.0 {
             &table.not_one
-        } else if cx == 0.0 {
+        } else if cx.abs() <= 0.0 {
             &table.not_zero
         } else {
             &table.all
@@ -636,6 +642,15 @@ impl ContactState {
 
     /// Quadrature nodes `(t, w p(t), S(t))` over the left slip, stick and right slip pieces.
     fn shape_nodes(&self, stick: &StickZone) -> Vec<(f64, f64, f64)> {
+        let mut table = self.shape_quadrature(stick);
+        for (t, w, _) in table.iter_mut() {
+            *w *= self.pressure_at(*t);
+        }
+        table
+    }
+
+    /// The nodes `(t, w, S(t))` of [`Self::shape_nodes`] without the pressure factor.
+    pub(crate) fn shape_quadrature(&self, stick: &StickZone) -> Vec<(f64, f64, f64)> {
         let ends = [
             self.centre - self.half_width,
             stick.lo,
@@ -648,7 +663,7 @@ impl ContactState {
             let (mid, half) = (0.5 * (seg[0] + seg[1]), 0.5 * (seg[1] - seg[0]));
             for (u, w) in nodes.iter().zip(weights) {
                 let tt = mid + half * u;
-                table.push((tt, w * half * self.pressure_at(tt), self.slip_shape(tt)));
+                table.push((tt, w * half, self.slip_shape(tt)));
             }
         }
         table

@@ -17,7 +17,7 @@
 //! `(1/π)⨍ w(θ)/(θ − τ) dθ = −(w13/y33) q(c + aτ)`, `∫ w dx = Γ − kP`.
 
 use crate::error::SolveFailure;
-use crate::quadrature::{BoundedGrid, BoundedSeries, UnboundedGrid, UnboundedSeries};
+use crate::quadrature::{BoundedGrid, BoundedSeries, RowMatrix, UnboundedGrid, UnboundedSeries};
 
 use super::{ChargeSplit, ContactModel};
 
@@ -31,6 +31,10 @@ pub struct Discretisation {
     /// ψ₁: response to `−τ` (unit `1/(RY*)`), with its integral.
     unit_psi: Vec<f64>,
     unit_integral: f64,
+    /// Density rows ([`BoundedSeries::density_row`]) of a bounded series at the bounded
+    /// collocation points, then at the unbounded ones (2M rows): the pressure at the points
+    /// where the tangential solver samples the shear traction.
+    pub bounded_at_collocation: RowMatrix,
 }
 
 impl Discretisation {
@@ -42,11 +46,22 @@ impl Discretisation {
         let mut unit_psi = vec![0.0; m];
         bounded.solve(&rhs, &mut unit_psi);
         let unit_integral = bounded.integral(&unit_psi);
+        let points: Vec<f64> = bounded
+            .collocation
+            .iter()
+            .chain(&unbounded.collocation)
+            .copied()
+            .collect();
+        let mut bounded_at_collocation = RowMatrix::zeros(points.len(), m);
+        for (i, &tau) in points.iter().enumerate() {
+            BoundedSeries::density_row(tau, bounded_at_collocation.row_mut(i));
+        }
         Self {
             bounded,
             unbounded,
             unit_psi,
             unit_integral,
+            bounded_at_collocation,
         }
     }
 

@@ -25,10 +25,13 @@
 //! the line search) and improved by Broyden's rank-one update after every accepted iterate.
 //! Each residual evaluation solves the linear problem at fixed geometry (pressure, charge and
 //! stick traction coupled through κq, w13 w and the slip traction) by a fixed-point iteration
-//! on the shear traction at the pressure and charge collocation points, with the factored
-//! matrices and Anderson acceleration; the parts that depend only on the geometry (the
-//! remembered strain, the inherited correction and its Cauchy transform, the slip-shape
-//! function) are evaluated once per evaluation. When no attempt of a step converges, the best
+//! on the shear traction at the pressure and charge collocation points, with Anderson
+//! acceleration; the parts that depend only on the geometry (the remembered strain, the
+//! inherited correction and its Cauchy transform, the slip-shape function, and the
+//! matrices that map series coefficients to values at the other unknowns' points) are built
+//! once per evaluation, so that a pass of the iteration is a handful of matrix–vector
+//! products (the collocation solves themselves are products with the precomputed
+//! transform-times-inverse matrices of [`crate::quadrature`]). When no attempt of a step converges, the best
 //! admissible iterate whose residual stalled below `SlipOptions::stall_tolerance` is accepted
 //! and keeps its residual in the step record. (Block Gauss–Seidel between the stick ends
 //! and (a, c), as in the seed paper, falls into 2-cycles when the contact shifts at a
@@ -79,7 +82,7 @@ use std::sync::Arc;
 use serde::Serialize;
 
 use crate::error::SolveFailure;
-use crate::quadrature::{BoundedSeries, UnboundedSeries};
+use crate::quadrature::{BoundedSeries, RowMatrix, UnboundedSeries, dot};
 
 use super::memory::Memory;
 use super::normal::arcsine_moment;
@@ -268,19 +271,90 @@ impl StepProblem<'_> {
             Vec::new()
         };
         let (np, nc) = (pressure_points.len(), fixed_c.len());
-        // The inner unknown: q at the pressure points, then at the charge points.
-        let mut x: Vec<f64> = pressure_points
+        // The linear maps of the inner iteration at this geometry as matrices on the series
+        // coefficients (each applied once per pass instead of a Clenshaw sum per point): at the
+        // stick points, the stick right-hand side from the pressure (`local p − η s y11 H'p`,
+        // over y11) and from the charge (`w13 w`, over y11); at the pressure and charge points,
+        // the density of the stick correction. The pressure's density at its own and the
+        // charge's collocation points does not depend on the geometry
+        // (`Discretisation::bounded_at_collocation`).
+        let mut row = vec![0.0; m];
+        let mut stick_from_p = RowMatrix::zeros(m + 1, m);
+        let mut stick_from_w = RowMatrix::zeros(if split.conducting { m + 1 } else { 0 }, m);
+        let mut cauchy_at_stick = RowMatrix::zeros(if mixed { m + 1 } else { 0 }, m);
+        let mut fixed = fixed;
+        for (i, &xs) in stick_points.iter().enumerate() {
+            let tau = (xs - g.c) / g.a;
+            BoundedSeries::density_row(tau, &mut row);
+            let out = stick_from_p.row_mut(i);
+            for (o, r) in out.iter_mut().zip(&row) {
+                *o = local / y11 * r;
+            }
+            BoundedSeries::cauchy_row(tau, &mut row);
+            if mixed {
+                cauchy_at_stick.row_mut(i).copy_from_slice(&row);
+            } else {
+                for (o, r) in out.iter_mut().zip(&row) {
+                    *o -= eta * self.signs.0 * r;
+                }
+            }
+            if split.conducting {
+                UnboundedSeries::density_row(tau, stick_from_w.row_mut(i));
+                for v in stick_from_w.row_mut(i) {
+                    *v *= w13 / y11;
+                }
+            } else {
+                // No charge unknown: whatever charge the state carries is fixed.
+                fixed[i] += w13 * state.potential_charge.density(tau) / y11;
+            }
+        }
+        let sample_points: Vec<f64> = pressure_points
             .iter()
             .chain(&charge_points[..nc])
+            .copied()
+            .collect();
+        let mut own_at_samples = RowMatrix::zeros(np + nc, m);
+        for (k, &xq) in sample_points.iter().enumerate() {
+            BoundedSeries::density_row((xq - mid) / half, own_at_samples.row_mut(k));
+        }
+        // Mixed slip signs: `H'(pS)(x) = S(x) H'p(x) + (1/π)∫ p(t)(S(t) − S(x))/(t − x) dt` at
+        // the stick points (as `ContactState::shape_cauchy`), the integral by the graded nodes
+        // of the slip and stick pieces: p at the nodes, then the quotient weights.
+        let (shape_nodes, shape_weights) = if mixed {
+            let stick = state.traction.stick.as_ref().expect("set above");
+            let table = state.shape_quadrature(stick);
+            let mut at_nodes = RowMatrix::zeros(table.len(), m);
+            for (j, &(t, _, _)) in table.iter().enumerate() {
+                BoundedSeries::density_row((t - g.c) / g.a, at_nodes.row_mut(j));
+            }
+            let mut weights = RowMatrix::zeros(m + 1, table.len());
+            for (i, &xs) in stick_points.iter().enumerate() {
+                let sx = state.slip_shape(xs);
+                for (wij, &(t, w, st)) in weights.row_mut(i).iter_mut().zip(&table) {
+                    if (t - xs).abs() > 1e-14 * g.a {
+                        *wij = w * (st - sx) / (t - xs) / std::f64::consts::PI;
+                    }
+                }
+            }
+            (at_nodes, weights)
+        } else {
+            (RowMatrix::default(), RowMatrix::default())
+        };
+        let stick_shape: Vec<f64> = stick_points.iter().map(|&x| state.slip_shape(x)).collect();
+        // The inner unknown: q at the pressure points, then at the charge points.
+        let mut x: Vec<f64> = sample_points
+            .iter()
             .map(|&x| guess.traction_at(x))
             .collect();
         let mut fx = vec![0.0; np + nc];
         let mut rhs = vec![0.0; m + 1];
-        let mut psi = vec![0.0; m];
-        let mut psi_q = vec![0.0; m];
-        let mut theta = vec![0.0; m];
+        let mut beta_p = vec![0.0; m];
+        let mut beta_q = vec![0.0; m];
+        let mut gamma = vec![0.0; m];
         let mut srhs = vec![0.0; m + 1];
         let mut crhs = vec![0.0; m.saturating_sub(1)];
+        let mut work = vec![0.0; m + 1];
+        let mut p_nodes = vec![0.0; shape_nodes.rows()];
         let scale = 1.0 / (model.radius * ystar);
         let p_scale = g.a * scale;
         let (mut lambda_p, mut lambda_q) = (0.0, 0.0);
@@ -290,8 +364,8 @@ impl StepProblem<'_> {
             for ((r, &xp), q) in rhs.iter_mut().zip(&pressure_points).zip(&x[..np]) {
                 *r = -xp * scale - kappa / ystar * q;
             }
-            lambda_p = disc.bounded.solve(&rhs, &mut psi);
-            state.pressure = BoundedSeries::from_nodes(&disc.bounded, &psi);
+            lambda_p = disc.bounded.solve_coefficients(&rhs, &mut beta_p);
+            state.pressure.beta.clone_from(&beta_p);
             // Charge (seed eqs. 53, 55, 41–42) for the current shear traction. The arcsine
             // moment of q fixes Γ under potential control; under charge control it only gives
             // φ0 and is evaluated once for the accepted state.
@@ -312,43 +386,37 @@ impl StepProblem<'_> {
                 for (r, q) in crhs.iter_mut().zip(&x[np..]) {
                     *r = -e.w13 / e.y33 * q;
                 }
-                disc.unbounded.solve(&crhs, free / g.a, &mut theta);
-                state.potential_charge = UnboundedSeries::from_nodes(&disc.unbounded, &theta);
+                disc.unbounded
+                    .solve_coefficients(&crhs, free / g.a, &mut gamma);
+                state.potential_charge.gamma.clone_from(&gamma);
             }
             // Stick traction (seed eqs. 50–51/58–59, 60, 63); `H'(pS)` is `s H'p` when both slip
-            // zones have the sign s.
+            // zones have the same sign s.
+            stick_from_p.apply(&beta_p, &mut srhs);
+            if split.conducting {
+                stick_from_w.apply(&gamma, &mut work);
+                for (r, w) in srhs.iter_mut().zip(&work) {
+                    *r += w;
+                }
+            }
             if mixed {
-                state.tabulate_shape();
+                cauchy_at_stick.apply(&beta_p, &mut work);
+                shape_nodes.apply(&beta_p, &mut p_nodes);
+                for (i, r) in srhs.iter_mut().enumerate() {
+                    let shape = stick_shape[i] * work[i] + dot(shape_weights.row(i), &p_nodes);
+                    *r -= eta * shape;
+                }
             }
-            for ((r, &xs), f) in srhs.iter_mut().zip(&stick_points).zip(&fixed) {
-                let tau = (xs - g.c) / g.a;
-                let shape = if mixed {
-                    state.shape_cauchy(xs)
-                } else {
-                    self.signs.0 * state.pressure.cauchy(tau)
-                };
-                *r = f
-                    + (local * state.pressure.density(tau)
-                        + w13 * state.potential_charge.density(tau)
-                        - eta * y11 * shape)
-                        / y11;
+            for (r, f) in srhs.iter_mut().zip(&fixed) {
+                *r += f;
             }
-            lambda_q = disc.bounded.solve(&srhs, &mut psi_q);
-            let own = BoundedSeries::from_nodes(&disc.bounded, &psi_q);
-            let (mid, half) = (0.5 * (g.lo + g.hi), 0.5 * (g.hi - g.lo));
-            let q_at = |xq: f64, (shape, inh): (f64, f64)| {
-                eta * state.pressure.density((xq - g.c) / g.a) * shape
-                    + own.density((xq - mid) / half)
-                    + inh
-            };
-            for (k, &xq) in pressure_points.iter().enumerate() {
-                fx[k] = q_at(xq, fixed_p[k]);
-            }
-            for (k, &xq) in charge_points[..nc].iter().enumerate() {
-                fx[np + k] = q_at(xq, fixed_c[k]);
+            lambda_q = disc.bounded.solve_coefficients(&srhs, &mut beta_q);
+            for (k, (shape, inh)) in fixed_p.iter().chain(&fixed_c).enumerate() {
+                let p = dot(disc.bounded_at_collocation.row(k), &beta_p);
+                fx[k] = eta * p * shape + dot(own_at_samples.row(k), &beta_q) + inh;
             }
             if let Some(stick) = state.traction.stick.as_mut() {
-                stick.correction = own;
+                stick.correction.beta.clone_from(&beta_q);
             }
             let p0 = state.pressure_at(g.c).abs().max(1e-300);
             let change = fx
