@@ -279,6 +279,8 @@ pub struct DriverState {
     pub displacement: f64,
     /// The material point at which δ is followed while it sticks (m).
     anchor: f64,
+    /// `ux` of the committed state at the anchor, once computed: `(anchor, ux)` (m).
+    anchor_ux: Option<(f64, f64)>,
     /// Dissipation of the last step (J/m).
     last_dissipation: f64,
     /// Work of P in the last step (J/m).
@@ -314,6 +316,7 @@ impl DriverState {
                 .stick
                 .as_ref()
                 .map_or(0.0, |z| z.mid()),
+            anchor_ux: None,
             last_dissipation: 0.0,
             last_normal_work: 0.0,
             approach: None,
@@ -475,8 +478,13 @@ pub fn advance(
             new_zone.mid()
         };
     }
-    let (d_delta, dissipation) =
-        step_increments(model, &driver.state, &solved.state, driver.anchor);
+    let old_ux = driver
+        .anchor_ux
+        .filter(|(x, _)| x.to_bits() == driver.anchor.to_bits())
+        .map(|(_, u)| u);
+    let (d_delta, dissipation, new_ux) =
+        step_increments(model, &driver.state, &solved.state, driver.anchor, old_ux);
+    driver.anchor_ux = Some((driver.anchor, new_ux));
     driver.displacement += d_delta;
     driver.last_dissipation = dissipation;
     let old = &driver.state;
@@ -565,16 +573,22 @@ fn record(
 /// dissipated energy `−∫ q̄ Δs dx` (q̄ the mean of the two tractions, second order in the step)
 /// is evaluated after an integration by parts as `∓∫ Δε(t) T(t) dt`, with T the integral of q̄
 /// from t to the contact end, so that Δε is needed only at the quadrature nodes.
+///
+/// Returns `(Δδ, dissipation, ux_new(anchor))`; `old_ux` is `ux_old(anchor)` when already known
+/// (the previous step's `ux_new` at the same anchor), computed otherwise.
 pub fn step_increments(
     model: &ContactModel,
     old: &ContactState,
     new: &ContactState,
     anchor: f64,
-) -> (f64, f64) {
+    old_ux: Option<f64>,
+) -> (f64, f64, f64) {
+    let new_ux = new.surface_displacement(model, anchor);
     let Some(stick) = new.traction.stick.as_ref() else {
-        return (0.0, 0.0);
+        return (0.0, 0.0, new_ux);
     };
-    let d_delta = new.surface_displacement(model, anchor) - old.surface_displacement(model, anchor);
+    let old_ux = old_ux.unwrap_or_else(|| old.surface_displacement(model, anchor));
+    let d_delta = new_ux - old_ux;
     let q_mean = |x: f64| 0.5 * (old.traction_at(x) + new.traction_at(x));
     let d_strain = |x: f64| new.strain_at(model, x) - old.strain_at(model, x);
     let left_end = (old.centre - old.half_width).min(new.centre - new.half_width);
@@ -604,7 +618,7 @@ pub fn step_increments(
         .iter()
         .map(|&(t, w, _, before)| w * d_strain(t) * before)
         .sum();
-    (d_delta, -right + left)
+    (d_delta, -right + left, new_ux)
 }
 
 /// A finished run: the records and the final driver state.
