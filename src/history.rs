@@ -595,6 +595,18 @@ pub fn step_increments(
     let right_end = (old.centre + old.half_width).max(new.centre + new.half_width);
     let mut breaks = new.traction_breakpoints();
     breaks.extend(old.traction_breakpoints());
+    // The strain change is singular at both states' contact ends as well (the old end lies
+    // inside the integration range when the contact grows or shifts). Measured on the default
+    // history: without these points the step dissipation differs from the one with them by up
+    // to 1e−4 of itself (3e−2 at the first steps after a reversal, where it is small); with
+    // them the 96- and 32-node rules agree to 2e−9 at every step but one (4e−4 at the
+    // unloading step to −0.4 ηP, where some other non-smooth point remains unresolved).
+    breaks.extend([
+        old.centre - old.half_width,
+        old.centre + old.half_width,
+        new.centre - new.half_width,
+        new.centre + new.half_width,
+    ]);
     // q̄ and Δε on the graded nodes of each slip zone, split at the traction's breakpoints,
     // with the running integral of q̄ for the inner integral.
     let table = |from: f64, to: f64| {
