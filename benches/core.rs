@@ -28,7 +28,7 @@ fn normal(c: &mut Criterion) {
     let sc = default_scenario();
     let mut g = c.benchmark_group("solve/normal_loading");
     g.sample_size(10);
-    for m in [32, 64, 128] {
+    for m in SIZES {
         let disc = Discretisation::new(m);
         g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
             b.iter(|| {
@@ -93,18 +93,12 @@ fn bench_step(c: &mut Criterion, name: &str, sizes: &[usize], loads: &[f64], nex
 
 fn steps(c: &mut Criterion) {
     // In the middle of the first forward phase.
-    bench_step(
-        c,
-        "solve/forward_step",
-        &[32, 64, 128, 256, 512],
-        &[0.1, 0.2, 0.3],
-        0.35,
-    );
+    bench_step(c, "solve/forward_step", &SIZES, &[0.1, 0.2, 0.3], 0.35);
 }
 
 fn reversal(c: &mut Criterion) {
     // The first step after the turning point at +½ηP.
-    bench_step(c, "solve/reversal_step", &[32, 64], &default_loads(0), 0.45);
+    bench_step(c, "solve/reversal_step", &SIZES, &default_loads(0), 0.45);
 }
 
 fn cycle(c: &mut Criterion) {
@@ -159,7 +153,7 @@ fn steady_cycle(c: &mut Criterion) {
     let sc = default_scenario();
     let mut g = c.benchmark_group("cycle/steady_cycle");
     g.sample_size(10);
-    for m in [32, 64] {
+    for m in SIZES {
         let disc = Discretisation::new(m);
         let before = default_loads(1);
         let driver = driver_after(&sc, &disc, &before);

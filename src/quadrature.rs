@@ -82,6 +82,20 @@ impl RowMatrix {
     }
 }
 
+/// The M × M transform (row-major) times the first M rows of `inverse`, as a matrix with
+/// `rows` rows (rows beyond M left zero) and as many columns as `inverse`.
+fn transform_times(transform: &[f64], m: usize, inverse: &Mat<f64>, rows: usize) -> RowMatrix {
+    let t = Mat::<f64>::from_fn(m, m, |n, l| transform[n * m + l]);
+    let product = t * inverse.as_ref().subrows(0, m);
+    let mut out = RowMatrix::zeros(rows, inverse.ncols());
+    for n in 0..m {
+        for (r, v) in out.row_mut(n).iter_mut().enumerate() {
+            *v = product[(n, r)];
+        }
+    }
+    out
+}
+
 /// `Σ a_i b_i` with four partial sums (which the compiler can keep in vector registers).
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
@@ -154,13 +168,7 @@ impl BoundedGrid {
             }
         }
         let inverse = lu.inverse();
-        let mut solution = RowMatrix::zeros(m + 1, m + 1);
-        for n in 0..m {
-            let row = &transform[n * m..(n + 1) * m];
-            for (r, out) in solution.row_mut(n).iter_mut().enumerate() {
-                *out = (0..m).map(|l| row[l] * inverse[(l, r)]).sum();
-            }
-        }
+        let mut solution = transform_times(&transform, m, &inverse, m + 1);
         for (r, out) in solution.row_mut(m).iter_mut().enumerate() {
             *out = inverse[(m, r)];
         }
@@ -248,13 +256,7 @@ impl UnboundedGrid {
             }
         }
         let inverse = lu.inverse();
-        let mut solution = RowMatrix::zeros(m, m);
-        for n in 0..m {
-            let row = &transform[n * m..(n + 1) * m];
-            for (r, out) in solution.row_mut(n).iter_mut().enumerate() {
-                *out = (0..m).map(|l| row[l] * inverse[(l, r)]).sum();
-            }
-        }
+        let solution = transform_times(&transform, m, &inverse, m);
         Self {
             m,
             nodes,
