@@ -650,6 +650,12 @@ mod tests {
         }
         let series = BoundedSeries::from_nodes(&g, &psi);
         assert!((series.beta[0] - 0.5).abs() < 1e-13 && (series.beta[2] - 1.0).abs() < 1e-13);
+        // The same by the one product with the precomputed transform times the inverse.
+        let mut beta = vec![0.0; m];
+        assert!((g.solve_coefficients(&rhs, &mut beta) - 0.25).abs() < 1e-13);
+        for (b, s) in beta.iter().zip(&series.beta) {
+            assert!((b - s).abs() < 1e-13);
+        }
         assert!((g.integral(&psi) - series.integral()).abs() < 1e-13);
         assert!((series.integral() - PI / 4.0).abs() < 1e-13);
         // Cauchy transform inside and outside, against direct formulas for ψ = 1 (β_1 = 1).
@@ -662,42 +668,6 @@ mod tests {
             assert!((one.cauchy(x) - exact).abs() < 1e-14);
         }
         assert!((series.psi(1.0) - (3.0 + 0.5)).abs() < 1e-12, "U_2(1) = 3");
-    }
-
-    #[test]
-    fn precomputed_solutions_match_the_factored_solves() {
-        // h = −T_3 − 0.5 T_1 + 0.25: β = (0.5, 0, 1, 0, …), λ = 0.25 (as above), now by the
-        // single product with the transform times the inverse.
-        let m = 20;
-        let g = BoundedGrid::new(m);
-        let rhs: Vec<f64> = g
-            .collocation
-            .iter()
-            .map(|&x| -t(3, x) - 0.5 * t(1, x) + 0.25)
-            .collect();
-        let mut beta = vec![0.0; m];
-        let lambda = g.solve_coefficients(&rhs, &mut beta);
-        assert!((lambda - 0.25).abs() < 1e-13);
-        for (n, b) in beta.iter().enumerate() {
-            let expected = [0.5, 0.0, 1.0].get(n).copied().unwrap_or(0.0);
-            assert!((b - expected).abs() < 1e-13, "β_{}", n + 1);
-        }
-        // ϑ = 2 + T_2 − 0.5 T_5 from h = U_1 − 0.5 U_4 and resultant 2π.
-        let g = UnboundedGrid::new(16);
-        let rhs: Vec<f64> = g
-            .collocation
-            .iter()
-            .map(|&x| u(1, x) - 0.5 * u(4, x))
-            .collect();
-        let mut gamma = vec![0.0; 16];
-        g.solve_coefficients(&rhs, 2.0 * PI, &mut gamma);
-        for (n, v) in gamma.iter().enumerate() {
-            let expected = [2.0, 0.0, 1.0, 0.0, 0.0, -0.5]
-                .get(n)
-                .copied()
-                .unwrap_or(0.0);
-            assert!((v - expected).abs() < 1e-12, "γ_{n}");
-        }
     }
 
     #[test]
@@ -760,9 +730,13 @@ mod tests {
         let mut th = vec![0.0; m];
         g.solve(&rhs, 2.0 * PI, &mut th);
         let series = UnboundedSeries::from_nodes(&g, &th);
+        let mut gamma = vec![0.0; m];
+        g.solve_coefficients(&rhs, 2.0 * PI, &mut gamma);
         let expected = [2.0, 0.0, 1.0, 0.0, 0.0, -0.5];
-        for (n, e) in expected.iter().enumerate() {
-            assert!((series.gamma[n] - e).abs() < 1e-12, "γ_{n}");
+        for (n, (g_lu, g_product)) in series.gamma.iter().zip(&gamma).enumerate() {
+            let e = expected.get(n).copied().unwrap_or(0.0);
+            assert!((g_lu - e).abs() < 1e-12, "γ_{n}");
+            assert!((g_product - e).abs() < 1e-12, "γ_{n} by the product");
         }
         assert!((series.integral() - 2.0 * PI).abs() < 1e-12);
         // Outside Cauchy transform of 1/√(1−t²): −sgn(x)/√(x²−1).
