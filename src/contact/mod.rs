@@ -439,16 +439,38 @@ impl StickZone {
 
     /// q̃ at x (Pa), including the inherited chain.
     pub fn correction_at(&self, x: f64) -> f64 {
-        let u = (x - self.mid()) / self.half();
-        let own = self.correction.density(u) + self.kink * kink_density(u);
-        own + self.inherited.as_ref().map_or(0.0, |z| z.value(x))
+        self.own_part(x, BoundedSeries::density, kink_density)
+            + self.inherited.as_ref().map_or(0.0, |z| z.value(x))
     }
 
     /// `H'q̃(x)` (Pa), including the inherited chain.
     pub fn correction_cauchy(&self, x: f64) -> f64 {
+        self.own_part(x, BoundedSeries::cauchy, kink_cauchy)
+            + self.inherited.as_ref().map_or(0.0, |z| z.cauchy(x))
+    }
+
+    /// The zone's own series and kink term through `series` and `kink` (density or Cauchy
+    /// transform); terms that are absent (no coefficients, no kink) are not evaluated.
+    fn own_part(
+        &self,
+        x: f64,
+        series: fn(&BoundedSeries, f64) -> f64,
+        kink: fn(f64) -> f64,
+    ) -> f64 {
         let u = (x - self.mid()) / self.half();
-        let own = self.correction.cauchy(u) + self.kink * kink_cauchy(u);
-        own + self.inherited.as_ref().map_or(0.0, |z| z.cauchy(x))
+        let mut own = 0.0;
+        if !self.correction.beta.is_empty() {
+            own += series(&self.correction, u);
+        }
+        if self.kink.abs() > 0.0 {
+            own += self.kink * kink(u);
+        }
+        own
+    }
+
+    /// Whether the zone carries nothing of its own: q̃ is exactly its inherited link's.
+    fn carries_nothing(&self) -> bool {
+        self.correction.beta.is_empty() && self.kink.abs() <= 0.0
     }
 
     /// `∫ q̃ dx` (N/m), including the inherited chain (the kink part is odd).
@@ -489,7 +511,18 @@ impl StickZone {
             } else {
                 None
             };
-            if let Some(c) = candidate {
+            if let Some(mut c) = candidate {
+                // A zone that carries nothing of its own and inherits an earlier zone whole
+                // has exactly that zone's q̃ (a return to a remembered state, once per cycle):
+                // carry the earlier zone instead, so that chains do not grow with the cycles.
+                while let Some(inner) = c
+                    .zone
+                    .inherited
+                    .as_ref()
+                    .filter(|i| c.zone.carries_nothing() && !i.faded())
+                {
+                    c.zone = inner.zone.clone();
+                }
                 return Some(std::sync::Arc::new(c));
             }
             zone = z.inherited.as_ref().map(|i| i.zone.clone());
@@ -683,6 +716,19 @@ impl ContactState {
         let t = &self.traction;
         if let (Some(stick), true) = (&t.stick, (t.left_sign - t.right_sign).abs() > 0.0) {
             self.shape_table = Some(std::sync::Arc::new(self.shape_nodes(stick)));
+        }
+    }
+
+    /// Replace the stick zone's own correction by none when all its coefficients are below
+    /// 1e−14 of `η p(c)`, i.e. far below the residual tolerance of a step (1e−13): the traction
+    /// changes by less than that, and every later evaluation of the chain skips the series.
+    pub fn drop_negligible_correction(&mut self, friction: f64) {
+        let scale = 1e-14 * friction * self.pressure_at(self.centre).abs();
+        if let Some(stick) = self.traction.stick.as_mut()
+            && stick.kink.abs() <= 0.0
+            && stick.correction.beta.iter().all(|b| b.abs() <= scale)
+        {
+            stick.correction = BoundedSeries::default();
         }
     }
 

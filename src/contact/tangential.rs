@@ -886,8 +886,12 @@ fn solve_geometry(
             state.potential = potential;
         }
         // The accepted state is evaluated many times from here on (checks, increments,
-        // memory): tabulate its shape quadrature once.
+        // memory): tabulate its shape quadrature once, and drop an own correction that is
+        // round-off (a return to a remembered state inherits that state whole and adds
+        // nothing; its own series, about 1e−16 of ηp0, would otherwise cost a Clenshaw sum at
+        // every later evaluation of every state whose chain holds it, one more per cycle).
         state.tabulate_shape();
+        state.drop_negligible_correction(model.friction);
         let admissibility = assess_step(model, start, &state);
         check(&admissibility, options.admissibility)?;
         Ok(SlipStep {

@@ -693,6 +693,46 @@ fn sliding_ends_carry_the_dissimilar_contact_exponent() {
     check(&driver.state, "Q = 0.3 ηP");
 }
 
+/// Each return to a remembered turning state inherits that state whole and adds nothing of its
+/// own, so the inherited correction chain (whose length sets the cost of every evaluation of a
+/// state) must stop growing once the cycles are steady: the default cycle at M = 32 in steps of
+/// 0.1 ηP ends with the same chain and the same state after 3 and after 6 cycles (before the
+/// chains were collapsed, one link was added per cycle).
+#[test]
+fn inherited_chains_stop_growing_in_steady_cycles() {
+    use fretsim::contact::tangential::SlipOptions;
+    use fretsim::history::{LoadHistory, NoObserver, run_history};
+    let b = baseline(32);
+    let end_of = |repeats: usize| {
+        let points = LoadHistory::with_cycles(
+            &[(0.0, 0.0), (1.0, 0.5 * b.lim)],
+            &[(2.0, -0.5 * b.lim), (4.0, 0.5 * b.lim)],
+            repeats,
+        );
+        let history = LoadHistory {
+            points,
+            steps_per_segment: 1,
+            max_step: 0.1 * b.lim,
+        };
+        let run = run_history(
+            &b.model,
+            &b.disc,
+            &b.normal,
+            &history,
+            SlipOptions::default(),
+            &mut NoObserver,
+        )
+        .unwrap();
+        run.driver.state
+    };
+    let (three, six) = (end_of(3), end_of(6));
+    let zone = |s: &fretsim::contact::ContactState| s.traction.stick.clone().unwrap();
+    let (z3, z6) = (zone(&three), zone(&six));
+    assert_eq!(z3.chain_len(), z6.chain_len());
+    let a = three.half_width;
+    assert!((z3.lo - z6.lo).abs() < 1e-12 * a && (z3.hi - z6.hi).abs() < 1e-12 * a);
+}
+
 /// The Cattaneo–Mindlin–Deresiewicz fretting loop of a Hertzian line contact (β = 0), with the
 /// datum d of the regularised kernel: δ on every step against the closed form
 /// (`analytical::CattaneoMindlin::loading_displacement`, Masing branches), the loop area
