@@ -769,6 +769,38 @@ pub fn graded_integral(mut points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> f64 {
         .sum()
 }
 
+/// The ends of the quadrature pieces: `points` sorted and deduplicated, then every piece more
+/// than three times as long as a neighbour halved until none is. A singular point at the end
+/// of a short piece lies just outside its long neighbour, at a distance small against that
+/// neighbour's length, where a fixed rule converges slowly (measured: 1.6e−3 between the 32-
+/// and 96-node rules on such a piece of the dissipation integral, 0.048a long with the
+/// neighbouring stick end 0.003a beyond it); after halving, every singular point is at least
+/// about a third of a piece length away from the pieces it does not end.
+fn piece_ends(mut points: Vec<f64>) -> Vec<f64> {
+    points.sort_by(f64::total_cmp);
+    points.dedup();
+    loop {
+        let lengths: Vec<f64> = points.windows(2).map(|w| w[1] - w[0]).collect();
+        let too_long = |i: usize| {
+            let neighbour = [i.checked_sub(1), (i + 1 < lengths.len()).then_some(i + 1)]
+                .into_iter()
+                .flatten()
+                .map(|j| lengths[j])
+                .fold(f64::INFINITY, f64::min);
+            lengths[i] > 3.0 * neighbour
+        };
+        let split: Vec<f64> = (0..lengths.len())
+            .filter(|&i| too_long(i))
+            .map(|i| 0.5 * (points[i] + points[i + 1]))
+            .collect();
+        if split.is_empty() {
+            return points;
+        }
+        points.extend(split);
+        points.sort_by(f64::total_cmp);
+    }
+}
+
 /// A function tabulated on the nodes of [`graded_integral`]'s pieces, with running integrals.
 #[derive(Debug, Clone, Default)]
 pub struct GradedTable {
@@ -778,8 +810,8 @@ pub struct GradedTable {
     pub total: f64,
 }
 
-/// Tabulate f on the graded rule over the pieces between `points` (as [`graded_integral`])
-/// together with the running integral up to each node, from the cumulative Gauss–Legendre
+/// Tabulate f on the graded rule over the pieces between `points` (as [`graded_integral`], the
+/// pieces balanced by [`piece_ends`]) together with the running integral up to each node, from the cumulative Gauss–Legendre
 /// matrix in the graded variable ([`crate::quadrature::gauss_legendre_cumulative`]). Nested
 /// integrals such as `∫ g(t) ∫_t^R f ds dt` then cost one evaluation of f per node.
 pub fn graded_cumulative(points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
@@ -828,11 +860,10 @@ impl GradedRule {
         }
     }
 
-    fn cumulative(&self, mut points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
+    fn cumulative(&self, points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
         let (nodes, weights) = (&self.nodes, &self.weights);
         let n = nodes.len();
-        points.sort_by(f64::total_cmp);
-        points.dedup();
+        let points = piece_ends(points);
         let mut table = GradedTable::default();
         for w in points.windows(2) {
             let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
@@ -1057,5 +1088,43 @@ impl ContactState {
                     / std::f64::consts::PI
         };
         self.contact_integral(Some(x), &integrand) + x * x / (2.0 * model.radius)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn piece_ends_keep_every_point_and_balance_neighbours() {
+        // A long piece next to a short one (a stick end 0.003 beyond a ramp end) is halved
+        // until no piece is more than three times as long as a neighbour.
+        let given = vec![-0.569840, -0.522144, -0.518976, 0.4, 0.4, -0.988128];
+        let ends = piece_ends(given.clone());
+        for p in &given {
+            assert!(ends.contains(p), "{p} kept");
+        }
+        assert!(
+            ends.windows(2).all(|w| w[1] > w[0]),
+            "sorted, no duplicates"
+        );
+        let lengths: Vec<f64> = ends.windows(2).map(|w| w[1] - w[0]).collect();
+        for pair in lengths.windows(2) {
+            assert!(
+                pair[0] <= 3.0 * pair[1] && pair[1] <= 3.0 * pair[0],
+                "{pair:?}"
+            );
+        }
+        // Halving only: a few extra points per decade of length ratio, not a uniform grid.
+        assert!(ends.len() < 30, "{} ends", ends.len());
+        // What the balance is for: ∫ ln|x − x0| over the pieces, x0 the end of the short piece
+        // and so just outside the long one. 32-node rule: relative error 1.3e−8 balanced,
+        // 1.1e−6 with the given pieces (measured); the bound is 1e−7.
+        let x0 = -0.518976;
+        let primitive = |x: f64| (x - x0) * (x - x0).abs().ln() - (x - x0);
+        let want = primitive(0.4) - primitive(-0.988128);
+        let table = graded_cumulative_coarse(given, &|x: f64| (x - x0).abs().ln());
+        let error = ((table.total - want) / want).abs();
+        assert!(error < 1e-7, "relative error {error:e}");
     }
 }

@@ -1060,7 +1060,8 @@ pub fn assess_step(
     // smooth (stick ends, inherited ends and the old contact ends), up to the inner of the
     // two contact ends (points that enter or leave the contact have no slip increment). The
     // 32-node rule per piece gives the slips to 3.4e−9 of the largest (measured against the
-    // 96-node rule over the default history), far inside the check's tolerance of 1e−2.
+    // 96-node rule over the default history, before the pieces were balanced), far inside the
+    // check's tolerance of 1e−2.
     let d_strain = |s: f64| new.strain_at(model, s) - old.strain_at(model, s);
     let mut breaks = new.traction_breakpoints();
     breaks.extend(old.traction_breakpoints());
