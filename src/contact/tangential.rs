@@ -27,13 +27,13 @@
 //! stick traction coupled through κq, w13 w and the slip traction) by a fixed-point iteration
 //! on the shear traction at the pressure and charge collocation points, with Anderson
 //! acceleration; the parts that depend only on the geometry (the remembered strain, the
-//! inherited correction and its Cauchy transform, the slip-shape function, and the
-//! matrices that map series coefficients to values at the other unknowns' points) are built
-//! once per evaluation, so that a pass of the iteration is a handful of matrix–vector
+//! inherited correction and its Cauchy transform, the slip-shape function, and the matrices
+//! that map series coefficients to values at the other unknowns' points, `InnerMaps`) are
+//! built once per evaluation, so that a pass of the iteration is a handful of matrix–vector
 //! products (the collocation solves themselves are products with the precomputed
-//! transform-times-inverse matrices of [`crate::quadrature`]). When no attempt of a step converges, the best
-//! admissible iterate whose residual stalled below `SlipOptions::stall_tolerance` is accepted
-//! and keeps its residual in the step record. (Block Gauss–Seidel between the stick ends
+//! transform-times-inverse matrices of [`crate::quadrature`]). When no attempt of a step
+//! converges, the best admissible iterate whose residual stalled below
+//! `SlipOptions::stall_tolerance` is accepted and keeps its residual in the step record. (Block Gauss–Seidel between the stick ends
 //! and (a, c), as in the seed paper, falls into 2-cycles when the contact shifts at a
 //! reversal.)
 //!
@@ -271,76 +271,29 @@ impl StepProblem<'_> {
             Vec::new()
         };
         let (np, nc) = (pressure_points.len(), fixed_c.len());
-        // The linear maps of the inner iteration at this geometry as matrices on the series
-        // coefficients (each applied once per pass instead of a Clenshaw sum per point): at the
-        // stick points, the stick right-hand side from the pressure (`local p − η s y11 H'p`,
-        // over y11) and from the charge (`w13 w`, over y11); at the pressure and charge points,
-        // the density of the stick correction. The pressure's density at its own and the
-        // charge's collocation points does not depend on the geometry
-        // (`Discretisation::bounded_at_collocation`).
-        let mut row = vec![0.0; m];
-        let mut stick_from_p = RowMatrix::zeros(m + 1, m);
-        let mut stick_from_w = RowMatrix::zeros(if split.conducting { m + 1 } else { 0 }, m);
-        let mut cauchy_at_stick = RowMatrix::zeros(if mixed { m + 1 } else { 0 }, m);
-        let mut fixed = fixed;
-        for (i, &xs) in stick_points.iter().enumerate() {
-            let tau = (xs - g.c) / g.a;
-            BoundedSeries::density_row(tau, &mut row);
-            let out = stick_from_p.row_mut(i);
-            for (o, r) in out.iter_mut().zip(&row) {
-                *o = local / y11 * r;
-            }
-            BoundedSeries::cauchy_row(tau, &mut row);
-            if mixed {
-                cauchy_at_stick.row_mut(i).copy_from_slice(&row);
-            } else {
-                for (o, r) in out.iter_mut().zip(&row) {
-                    *o -= eta * self.signs.0 * r;
-                }
-            }
-            if split.conducting {
-                UnboundedSeries::density_row(tau, stick_from_w.row_mut(i));
-                for v in stick_from_w.row_mut(i) {
-                    *v *= w13 / y11;
-                }
-            } else {
-                // No charge unknown: whatever charge the state carries is fixed.
-                fixed[i] += w13 * state.potential_charge.density(tau) / y11;
-            }
-        }
         let sample_points: Vec<f64> = pressure_points
             .iter()
             .chain(&charge_points[..nc])
             .copied()
             .collect();
-        let mut own_at_samples = RowMatrix::zeros(np + nc, m);
-        for (k, &xq) in sample_points.iter().enumerate() {
-            BoundedSeries::density_row((xq - mid) / half, own_at_samples.row_mut(k));
+        let maps = InnerMaps::new(
+            &state,
+            &stick_points,
+            &sample_points,
+            m,
+            Coefficients {
+                local_over_y11: local / y11,
+                shape: (!mixed).then_some(eta * self.signs.0),
+                charge: split.conducting.then_some(w13 / y11),
+            },
+        );
+        let mut fixed = fixed;
+        if !split.conducting {
+            // No charge unknown: whatever charge the state carries is fixed.
+            for (f, &xs) in fixed.iter_mut().zip(&stick_points) {
+                *f += w13 * state.potential_charge.density((xs - g.c) / g.a) / y11;
+            }
         }
-        // Mixed slip signs: `H'(pS)(x) = S(x) H'p(x) + (1/π)∫ p(t)(S(t) − S(x))/(t − x) dt` at
-        // the stick points (as `ContactState::shape_cauchy`), the integral by the graded nodes
-        // of the slip and stick pieces: p at the nodes, then the quotient weights.
-        let (shape_nodes, shape_weights) = if mixed {
-            let stick = state.traction.stick.as_ref().expect("set above");
-            let table = state.shape_quadrature(stick);
-            let mut at_nodes = RowMatrix::zeros(table.len(), m);
-            for (j, &(t, _, _)) in table.iter().enumerate() {
-                BoundedSeries::density_row((t - g.c) / g.a, at_nodes.row_mut(j));
-            }
-            let mut weights = RowMatrix::zeros(m + 1, table.len());
-            for (i, &xs) in stick_points.iter().enumerate() {
-                let sx = state.slip_shape(xs);
-                for (wij, &(t, w, st)) in weights.row_mut(i).iter_mut().zip(&table) {
-                    if (t - xs).abs() > 1e-14 * g.a {
-                        *wij = w * (st - sx) / (t - xs) / std::f64::consts::PI;
-                    }
-                }
-            }
-            (at_nodes, weights)
-        } else {
-            (RowMatrix::default(), RowMatrix::default())
-        };
-        let stick_shape: Vec<f64> = stick_points.iter().map(|&x| state.slip_shape(x)).collect();
         // The inner unknown: q at the pressure points, then at the charge points.
         let mut x: Vec<f64> = sample_points
             .iter()
@@ -354,7 +307,7 @@ impl StepProblem<'_> {
         let mut srhs = vec![0.0; m + 1];
         let mut crhs = vec![0.0; m.saturating_sub(1)];
         let mut work = vec![0.0; m + 1];
-        let mut p_nodes = vec![0.0; shape_nodes.rows()];
+        let mut p_nodes = vec![0.0; maps.shape_nodes.rows()];
         let scale = 1.0 / (model.radius * ystar);
         let p_scale = g.a * scale;
         let (mut lambda_p, mut lambda_q) = (0.0, 0.0);
@@ -392,18 +345,19 @@ impl StepProblem<'_> {
             }
             // Stick traction (seed eqs. 50–51/58–59, 60, 63); `H'(pS)` is `s H'p` when both slip
             // zones have the same sign s.
-            stick_from_p.apply(&beta_p, &mut srhs);
+            maps.stick_from_p.apply(&beta_p, &mut srhs);
             if split.conducting {
-                stick_from_w.apply(&gamma, &mut work);
+                maps.stick_from_w.apply(&gamma, &mut work);
                 for (r, w) in srhs.iter_mut().zip(&work) {
                     *r += w;
                 }
             }
             if mixed {
-                cauchy_at_stick.apply(&beta_p, &mut work);
-                shape_nodes.apply(&beta_p, &mut p_nodes);
+                maps.cauchy_at_stick.apply(&beta_p, &mut work);
+                maps.shape_nodes.apply(&beta_p, &mut p_nodes);
                 for (i, r) in srhs.iter_mut().enumerate() {
-                    let shape = stick_shape[i] * work[i] + dot(shape_weights.row(i), &p_nodes);
+                    let shape =
+                        maps.stick_shape[i] * work[i] + dot(maps.shape_weights.row(i), &p_nodes);
                     *r -= eta * shape;
                 }
             }
@@ -413,7 +367,7 @@ impl StepProblem<'_> {
             lambda_q = disc.bounded.solve_coefficients(&srhs, &mut beta_q);
             for (k, (shape, inh)) in fixed_p.iter().chain(&fixed_c).enumerate() {
                 let p = dot(disc.bounded_at_collocation.row(k), &beta_p);
-                fx[k] = eta * p * shape + dot(own_at_samples.row(k), &beta_q) + inh;
+                fx[k] = eta * p * shape + dot(maps.own_at_samples.row(k), &beta_q) + inh;
             }
             if let Some(stick) = state.traction.stick.as_mut() {
                 stick.correction.beta.clone_from(&beta_q);
@@ -448,6 +402,113 @@ impl StepProblem<'_> {
             (q_force - self.tangential_load) / (eta * self.normal_load),
         ];
         Ok((residual, state))
+    }
+}
+
+/// The coefficients that scale the rows of [`InnerMaps`].
+struct Coefficients {
+    /// `(w12 + χ w13)/y11`: the pressure's local term in the stick equation.
+    local_over_y11: f64,
+    /// `η s` when both slip zones have the sign s (the `−η s H'p` term folded into the
+    /// pressure rows); `None` for mixed signs, whose `H'(pS)` is assembled separately.
+    shape: Option<f64>,
+    /// `w13/y11` when the charge is an unknown (conducting punch).
+    charge: Option<f64>,
+}
+
+/// The linear maps of the inner iteration at one geometry, as matrices on the series
+/// coefficients (each applied once per pass instead of a Clenshaw sum per point): at the stick
+/// points, the stick right-hand side from the pressure (`local p − η s y11 H'p`, over y11) and
+/// from the charge (`w13 w`, over y11); at the pressure and charge points, the density of the
+/// stick correction. (The pressure's density at its own and the charge's collocation points
+/// does not depend on the geometry: `Discretisation::bounded_at_collocation`.) For mixed slip
+/// signs, `H'(pS)(x) = S(x) H'p(x) + (1/π)∫ p(t)(S(t) − S(x))/(t − x) dt` at the stick points
+/// (as `ContactState::shape_cauchy`) is kept in three parts: `H'p` at the stick points, p at
+/// the graded nodes of the slip and stick pieces, and the quotient weights.
+struct InnerMaps {
+    stick_from_p: RowMatrix,
+    stick_from_w: RowMatrix,
+    own_at_samples: RowMatrix,
+    cauchy_at_stick: RowMatrix,
+    shape_nodes: RowMatrix,
+    shape_weights: RowMatrix,
+    /// S at the stick points.
+    stick_shape: Vec<f64>,
+}
+
+impl InnerMaps {
+    /// The maps for `state`'s geometry (contact and stick zone) at the stick collocation
+    /// points and at the pressure-then-charge sample points, for series of M coefficients.
+    fn new(
+        state: &ContactState,
+        stick_points: &[f64],
+        sample_points: &[f64],
+        m: usize,
+        k: Coefficients,
+    ) -> Self {
+        let (c, a) = (state.centre, state.half_width);
+        let stick = state.traction.stick.as_ref().expect("stick zone set");
+        let rows = stick_points.len();
+        let mut row = vec![0.0; m];
+        let mut stick_from_p = RowMatrix::zeros(rows, m);
+        let mut stick_from_w = RowMatrix::zeros(if k.charge.is_some() { rows } else { 0 }, m);
+        let mut cauchy_at_stick = RowMatrix::zeros(if k.shape.is_none() { rows } else { 0 }, m);
+        for (i, &xs) in stick_points.iter().enumerate() {
+            let tau = (xs - c) / a;
+            BoundedSeries::density_row(tau, &mut row);
+            let out = stick_from_p.row_mut(i);
+            for (o, r) in out.iter_mut().zip(&row) {
+                *o = k.local_over_y11 * r;
+            }
+            BoundedSeries::cauchy_row(tau, &mut row);
+            match k.shape {
+                Some(eta_s) => {
+                    for (o, r) in out.iter_mut().zip(&row) {
+                        *o -= eta_s * r;
+                    }
+                }
+                None => cauchy_at_stick.row_mut(i).copy_from_slice(&row),
+            }
+            if let Some(w13_over_y11) = k.charge {
+                UnboundedSeries::density_row(tau, stick_from_w.row_mut(i));
+                for v in stick_from_w.row_mut(i) {
+                    *v *= w13_over_y11;
+                }
+            }
+        }
+        let (mid, half) = (stick.mid(), stick.half());
+        let mut own_at_samples = RowMatrix::zeros(sample_points.len(), m);
+        for (j, &xq) in sample_points.iter().enumerate() {
+            BoundedSeries::density_row((xq - mid) / half, own_at_samples.row_mut(j));
+        }
+        let (shape_nodes, shape_weights) = if k.shape.is_none() {
+            let table = state.shape_quadrature(stick);
+            let mut at_nodes = RowMatrix::zeros(table.len(), m);
+            for (j, &(t, _, _)) in table.iter().enumerate() {
+                BoundedSeries::density_row((t - c) / a, at_nodes.row_mut(j));
+            }
+            let mut weights = RowMatrix::zeros(rows, table.len());
+            for (i, &xs) in stick_points.iter().enumerate() {
+                let sx = state.slip_shape(xs);
+                for (wij, &(t, w, st)) in weights.row_mut(i).iter_mut().zip(&table) {
+                    if (t - xs).abs() > 1e-14 * a {
+                        *wij = w * (st - sx) / (t - xs) / std::f64::consts::PI;
+                    }
+                }
+            }
+            (at_nodes, weights)
+        } else {
+            (RowMatrix::default(), RowMatrix::default())
+        };
+        Self {
+            stick_from_p,
+            stick_from_w,
+            own_at_samples,
+            cauchy_at_stick,
+            shape_nodes,
+            shape_weights,
+            stick_shape: stick_points.iter().map(|&x| state.slip_shape(x)).collect(),
+        }
     }
 }
 
