@@ -810,10 +810,11 @@ pub struct GradedTable {
     pub total: f64,
 }
 
-/// Tabulate f on the graded rule over the pieces between `points` (as [`graded_integral`], the
-/// pieces balanced by [`piece_ends`]) together with the running integral up to each node, from the cumulative Gauss–Legendre
-/// matrix in the graded variable ([`crate::quadrature::gauss_legendre_cumulative`]). Nested
-/// integrals such as `∫ g(t) ∫_t^R f ds dt` then cost one evaluation of f per node.
+/// Tabulate f on the graded rule over the pieces between `points` (as [`graded_integral`], with
+/// the pieces balanced: none more than three times as long as a neighbour) together with the
+/// running integral up to each node, from the cumulative Gauss–Legendre matrix in the graded
+/// variable ([`crate::quadrature::gauss_legendre_cumulative`]). Nested integrals such as
+/// `∫ g(t) ∫_t^R f ds dt` then cost one evaluation of f per node.
 pub fn graded_cumulative(points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
     static FINE: std::sync::OnceLock<GradedRule> = std::sync::OnceLock::new();
     FINE.get_or_init(|| GradedRule::new(GRADED_NODES))

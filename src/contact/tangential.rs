@@ -33,9 +33,9 @@
 //! products (the collocation solves themselves are products with the precomputed
 //! transform-times-inverse matrices of [`crate::quadrature`]). When no attempt of a step
 //! converges, the best admissible iterate whose residual stalled below
-//! `SlipOptions::stall_tolerance` is accepted and keeps its residual in the step record. (Block Gauss–Seidel between the stick ends
-//! and (a, c), as in the seed paper, falls into 2-cycles when the contact shifts at a
-//! reversal.)
+//! `SlipOptions::stall_tolerance` is accepted and keeps its residual in the step record.
+//! (Block Gauss–Seidel between the stick ends and (a, c), as in the seed paper, falls into
+//! 2-cycles when the contact shifts at a reversal.)
 //!
 //! # Inherited corrections
 //! The memory has square-root kinks at the ends of earlier stick zones (the exterior Cauchy
