@@ -259,6 +259,9 @@ fn solve_normal_directed(
             state.traction.stick = Some(StickZone::new(-b_fin, b_fin, correction, kink));
             // The state is evaluated many times from here on (checks, fields, memory).
             state.tabulate_shape();
+            if let Some(zone) = state.traction.stick.as_ref() {
+                zone.tabulate_cauchy(disc.nodes() + 32);
+            }
             let admissibility = check_normal_state(model, &state, slope_fin, options.admissibility)
                 .map_err(|failure| {
                     if b_fin >= state.half_width {
