@@ -44,7 +44,10 @@
 //! correction of the zone that began the phase in closed form ([`super::Inherited`], faded out
 //! where the new zone ends inside the old one), and solves only for the smooth remainder. In
 //! the uncoupled limit this reproduces Cattaneo–Mindlin–Deresiewicz–Masing histories to
-//! round-off.
+//! round-off. An accepted zone drops an own correction that is round-off and carries its
+//! `H'q̃` tabulated piecewise (`StickZone::tabulate_cauchy`); a zone that carries nothing of
+//! its own is skipped when a later zone inherits it, so a steady history's chains stop
+//! growing.
 //!
 //! # States beyond the seed paper's form
 //! - Right after a reversal in a coupled contact the contact shifts, and one edge may keep its
