@@ -593,23 +593,15 @@ pub fn step_increments(
     let d_strain = |x: f64| new.strain_at(model, x) - old.strain_at(model, x);
     let left_end = (old.centre - old.half_width).min(new.centre - new.half_width);
     let right_end = (old.centre + old.half_width).max(new.centre + new.half_width);
-    let mut breaks = new.traction_breakpoints();
-    breaks.extend(old.traction_breakpoints());
-    // The strain change is singular at both states' contact ends as well (the old end lies
-    // inside the integration range when the contact grows or shifts). Measured on the default
-    // history: without these points the step dissipation differs from the one with them by up
-    // to 1e−4 of itself (3e−2 at the first steps after a reversal, where it is small); with
-    // them, and with the pieces balanced (`graded_cumulative` halves a piece that is more than
-    // three times as long as a neighbour, so that no singular point sits just outside a long
-    // piece), the 32- and 96-node rules agree to 2e−10 at every step, and the 32-node rule is
-    // used. (Unbalanced, one step, 0.048a of slip zone next to a 0.003a piece, was off by
-    // 4e−4 of itself even with 96 nodes.)
-    breaks.extend([
-        old.centre - old.half_width,
-        old.centre + old.half_width,
-        new.centre - new.half_width,
-        new.centre + new.half_width,
-    ]);
+    // Measured on the default history: without the contact ends among the breakpoints the
+    // step dissipation differs from the one with them by up to 1e−4 of itself (3e−2 at the
+    // first steps after a reversal, where it is small); with them, and with the pieces
+    // balanced (`graded_cumulative` halves a piece that is more than three times as long as a
+    // neighbour, so that no singular point sits just outside a long piece), the 32- and
+    // 96-node rules agree to 2e−10 at every step, and the 32-node rule is used. (Unbalanced,
+    // one step, 0.048a of slip zone next to a 0.003a piece, was off by 4e−4 of itself even
+    // with 96 nodes.)
+    let breaks = crate::contact::step_breakpoints(old, new);
     // q̄ and Δε on the graded nodes of each slip zone, split at the traction's breakpoints,
     // with the running integral of q̄ for the inner integral.
     let table = |from: f64, to: f64| {

@@ -393,14 +393,7 @@ impl Inherited {
     /// Breakpoints of the quadrature over the earlier zone.
     fn pieces(&self) -> Vec<f64> {
         let mut pts = vec![self.zone.lo];
-        // Singular points of q̃_E inside the earlier zone: the ends of the zones in its chain
-        // (square roots), their ramps, and centre kinks (see `kink_density`).
-        let mut inner: Vec<f64> = self.zone.kink_point().into_iter().collect();
-        for i in self.zone.links() {
-            inner.extend([i.zone.lo, i.zone.hi]);
-            inner.extend(i.zone.kink_point());
-            inner.extend(i.ramp_points());
-        }
+        let mut inner = self.zone.chain_points();
         inner.extend(self.ramp_points());
         let (lo, hi) = (self.zone.lo, self.zone.hi);
         let gap = 1e-9 * (hi - lo);
@@ -491,12 +484,7 @@ impl StickZone {
         self.cauchy_table.0.get_or_init(|| {
             let width = self.hi - self.lo;
             let mut points = vec![self.lo - width, self.lo, self.hi, self.hi + width];
-            points.extend(self.kink_point());
-            for i in self.links() {
-                points.extend([i.zone.lo, i.zone.hi]);
-                points.extend(i.zone.kink_point());
-                points.extend(i.ramp_points());
-            }
+            points.extend(self.chain_points());
             let slack = 1e-12 * width;
             points.retain(|&x| {
                 x <= self.lo || x >= self.hi || (x > self.lo + slack && x < self.hi - slack)
@@ -642,6 +630,19 @@ impl StickZone {
     /// The inherited corrections of the chain, outermost first.
     pub fn links(&self) -> impl Iterator<Item = &Inherited> {
         std::iter::successors(self.inherited.as_deref(), |i| i.zone.inherited.as_deref())
+    }
+
+    /// Where q̃ may fail to be smooth besides the zone's ends: the ends of the zones in its
+    /// chain (square roots), their fade ramps, and centre kinks (see [`kink_density`]); not
+    /// filtered to the zone.
+    fn chain_points(&self) -> Vec<f64> {
+        let mut points: Vec<f64> = self.kink_point().into_iter().collect();
+        for i in self.links() {
+            points.extend([i.zone.lo, i.zone.hi]);
+            points.extend(i.zone.kink_point());
+            points.extend(i.ramp_points());
+        }
+        points
     }
 
     /// The zone's centre when it carries a centre kink (see [`kink_density`]).
@@ -871,6 +872,18 @@ pub fn graded_integral(mut points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> f64 {
                 .sum::<f64>()
         })
         .sum()
+}
+
+/// Where the strain change between two states is not smooth: both states' traction
+/// breakpoints and both contact ends (the old end lies inside a slip zone of the new state
+/// when the contact grows or shifts).
+pub fn step_breakpoints(old: &ContactState, new: &ContactState) -> Vec<f64> {
+    let mut breaks = new.traction_breakpoints();
+    breaks.extend(old.traction_breakpoints());
+    for s in [old, new] {
+        breaks.extend([s.centre - s.half_width, s.centre + s.half_width]);
+    }
+    breaks
 }
 
 /// The ends of the quadrature pieces: `points` sorted and deduplicated, then every piece more

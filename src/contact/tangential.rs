@@ -235,11 +235,18 @@ impl StepProblem<'_> {
         let stick_points = mapped(&disc.bounded.collocation, mid, half);
         let pressure_points = mapped(&disc.bounded.collocation, g.c, g.a);
         let charge_points = mapped(&disc.unbounded.collocation, g.c, g.a);
-        // Parts of the stick right-hand side that do not change in the inner iteration.
+        // Parts of the stick right-hand side that do not change in the inner iteration (with
+        // no charge unknown, whatever charge the state carries is among them).
         let fixed: Vec<f64> = stick_points
             .iter()
             .map(|&x| {
+                let fixed_charge = if split.conducting {
+                    0.0
+                } else {
+                    w13 * guess.potential_charge.density((x - g.c) / g.a) / y11
+                };
                 self.memory.strain(model, x) / y11 - inherited.as_ref().map_or(0.0, |z| z.cauchy(x))
+                    + fixed_charge
             })
             .collect();
         let inherited_force = inherited.as_ref().map_or(0.0, |z| z.integral());
@@ -290,13 +297,6 @@ impl StepProblem<'_> {
                 charge: split.conducting.then_some(w13 / y11),
             },
         );
-        let mut fixed = fixed;
-        if !split.conducting {
-            // No charge unknown: whatever charge the state carries is fixed.
-            for (f, &xs) in fixed.iter_mut().zip(&stick_points) {
-                *f += w13 * state.potential_charge.density((xs - g.c) / g.a) / y11;
-            }
-        }
         // The inner unknown: q at the pressure points, then at the charge points.
         let mut x: Vec<f64> = sample_points
             .iter()
@@ -1127,15 +1127,13 @@ pub fn assess_step(
     }
     // Slip increments at points of each slip zone: the running integral of the strain change
     // from the stick end, by graded quadrature split at every point where either state is not
-    // smooth (stick ends, inherited ends and the old contact ends), up to the inner of the
+    // smooth ([`super::step_breakpoints`]), up to the inner of the
     // two contact ends (points that enter or leave the contact have no slip increment). The
     // 32-node rule per piece gives the slips to 3.4e−9 of the largest (measured against the
     // 96-node rule over the default history, before the pieces were balanced), far inside the
     // check's tolerance of 1e−2.
     let d_strain = |s: f64| new.strain_at(model, s) - old.strain_at(model, s);
-    let mut breaks = new.traction_breakpoints();
-    breaks.extend(old.traction_breakpoints());
-    breaks.extend([old.centre - old.half_width, old.centre + old.half_width]);
+    let breaks = super::step_breakpoints(old, new);
     let mut slips = Vec::new();
     let zones = [
         (
