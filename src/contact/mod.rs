@@ -938,10 +938,18 @@ pub fn graded_cumulative(points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTabl
         .cumulative(points, f)
 }
 
-/// As [`graded_cumulative`] with a 32-node rule per piece, for estimates that need a few
-/// digits only (the slip-direction check of a step).
+/// As [`graded_cumulative`] with a 32-node rule per piece (the dissipation of a step).
 pub fn graded_cumulative_coarse(points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
     coarse_rule().cumulative(points, f)
+}
+
+/// As [`graded_cumulative`] with a 16-node rule per piece, for estimates that need a few
+/// digits only (the slip-direction check of a step).
+pub fn graded_cumulative_rough(points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
+    static ROUGH: std::sync::OnceLock<GradedRule> = std::sync::OnceLock::new();
+    ROUGH
+        .get_or_init(|| GradedRule::new(16))
+        .cumulative(points, f)
 }
 
 /// `∫ f` as [`graded_integral`], on balanced pieces (as [`graded_cumulative`]) with a 32-node
