@@ -384,7 +384,12 @@ impl Inherited {
     /// `χ q̃_E` at x.
     pub fn value(&self, x: f64) -> f64 {
         if self.faded() {
-            self.chi(x) * self.zone.correction_at(x)
+            let chi = self.chi(x);
+            if chi.abs() > 0.0 {
+                chi * self.zone.correction_at(x)
+            } else {
+                0.0
+            }
         } else {
             self.zone.correction_at(x)
         }
@@ -429,7 +434,12 @@ impl Inherited {
             .filter(|(t, _, _)| (t - x).abs() > tiny)
             .map(|(t, wq, chi)| wq * (chi - cx) / (t - x))
             .sum();
-        cx * self.zone.correction_cauchy(x) + sum / std::f64::consts::PI
+        let own = if cx.abs() > 0.0 {
+            cx * self.zone.correction_cauchy(x)
+        } else {
+            0.0
+        };
+        own + sum / std::f64::consts::PI
     }
 
     /// `∫ χ q̃_E dx`.
@@ -520,8 +530,12 @@ impl StickZone {
         });
     }
 
-    /// q̃ at x (Pa), including the inherited chain.
+    /// q̃ at x (Pa), including the inherited chain; zero outside the zone (the zones a chain
+    /// carries whole lie inside it, and the faded ones are faded out at its ends).
     pub fn correction_at(&self, x: f64) -> f64 {
+        if !(x > self.lo && x < self.hi) {
+            return 0.0;
+        }
         self.own_part(x, BoundedSeries::density, kink_density)
             + self.inherited.as_ref().map_or(0.0, |z| z.value(x))
     }
