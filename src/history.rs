@@ -596,8 +596,8 @@ pub fn step_increments(
     // Measured on the default history: without the contact ends among the breakpoints the
     // step dissipation differs from the one with them by up to 1e−4 of itself (3e−2 at the
     // first steps after a reversal, where it is small); with them, and with the pieces
-    // balanced (`graded_cumulative` halves a piece that is more than three times as long as a
-    // neighbour, so that no singular point sits just outside a long piece), the 32- and
+    // balanced (`graded_cumulative_coarse` halves a piece that is more than three times as
+    // long as a neighbour, so that no singular point sits just outside a long piece), the 32- and
     // 96-node rules agree to 2e−10 at every step, and the 32-node rule is used. (Unbalanced,
     // one step, 0.048a of slip zone next to a 0.003a piece, was off by 4e−4 of itself even
     // with 96 nodes.)
