@@ -281,14 +281,8 @@ pub struct DriverState {
     anchor: f64,
     /// `ux` of the committed state at the anchor, once computed: `(anchor, ux)` (m).
     anchor_ux: Option<(f64, f64)>,
-    /// Dissipation of the last step (J/m).
-    last_dissipation: f64,
-    /// Work of P in the last step (J/m).
-    last_normal_work: f64,
     /// Normal approach δn of the current state (m), once computed.
     approach: Option<f64>,
-    /// Electric work in the last step (J/m).
-    last_electric_work: f64,
     /// Slip signs and Jacobian of the last step, the warm start of the next step of a phase.
     warm: Option<WarmStart>,
 }
@@ -317,10 +311,7 @@ impl DriverState {
                 .as_ref()
                 .map_or(0.0, |z| z.mid()),
             anchor_ux: None,
-            last_dissipation: 0.0,
-            last_normal_work: 0.0,
             approach: None,
-            last_electric_work: 0.0,
             warm: None,
         }
     }
@@ -362,7 +353,8 @@ pub struct LoadPoint {
     pub q: f64,
 }
 
-/// Advance the driver by one load step.
+/// Advance the driver by one load step: solve it ([`solve_step`]), compute its increments
+/// ([`StepIncrements::compute`]) and commit them ([`finish_step`]).
 pub fn advance(
     model: &ContactModel,
     disc: &Discretisation,
@@ -371,18 +363,166 @@ pub fn advance(
     options: SlipOptions,
     observer: &mut dyn Observer,
 ) -> Result<StepRecord, StepFailure> {
+    Ok(match solve_step(model, disc, driver, point, options)? {
+        Solved::Hold(regime) => hold_record(driver, point, regime, observer),
+        Solved::Slip(solved) => {
+            let inputs = solved.increment_inputs(driver);
+            let increments = StepIncrements::compute(model, &inputs);
+            finish_step(driver, *solved, increments, observer)
+        }
+    })
+}
+
+/// A solved step: a hold (nothing changes) or a slip step whose increments are still to be
+/// computed.
+pub enum Solved {
+    /// ΔQ = 0 (the regime is [`Regime::Stick`]).
+    Hold(Regime),
+    /// A slip step, committed to the driver except for its increments.
+    Slip(Box<SolvedStep>),
+}
+
+/// A slip step whose state is committed to the driver and whose increments (δ, dissipation,
+/// works) are still to be computed; they need only the two states and the anchor, so they
+/// can be computed while the next step is solved.
+pub struct SolvedStep {
+    /// The step's record without the increments.
+    record: StepRecord,
+    /// The committed state before the step.
+    old: ContactState,
+    /// The state of the step.
+    new: ContactState,
+    /// The material point at which δ is followed in this step.
+    anchor: f64,
+    /// The phase this step begins, with its memory (for the observer).
+    new_phase: Option<(usize, Memory)>,
+}
+
+/// What the increments of a step need.
+pub struct IncrementInputs {
+    /// The committed state before the step.
+    pub old: ContactState,
+    /// The state of the step.
+    pub new: ContactState,
+    /// The material point at which δ is followed (m).
+    pub anchor: f64,
+    /// `ux` of the old state at the anchor, when the previous step computed it (m).
+    pub old_ux: Option<f64>,
+    /// The normal approach of the old state, when already computed (m).
+    pub old_approach: Option<f64>,
+}
+
+/// The increments of a step and the values at its state that the next step reuses.
+#[derive(Debug, Clone, Copy)]
+pub struct StepIncrements {
+    /// Δδ (m).
+    pub displacement: f64,
+    /// Frictional dissipation (J/m).
+    pub dissipation: f64,
+    /// Work of P, `P Δδn` (J/m).
+    pub normal_work: f64,
+    /// Work of the electric load, `φ̄0 ΔΓ` (J/m).
+    pub electric_work: f64,
+    /// `ux` of the new state at the anchor (m).
+    pub new_ux: f64,
+    /// Normal approach δn of the new state (m).
+    pub new_approach: f64,
+}
+
+impl StepIncrements {
+    /// The increments between `inputs.old` and `inputs.new` ([`step_increments`],
+    /// [`ContactState::normal_approach`]).
+    pub fn compute(model: &ContactModel, inputs: &IncrementInputs) -> Self {
+        let (old, new) = (&inputs.old, &inputs.new);
+        let (displacement, dissipation, new_ux) =
+            step_increments(model, old, new, inputs.anchor, inputs.old_ux);
+        let old_approach = inputs
+            .old_approach
+            .unwrap_or_else(|| old.normal_approach(model));
+        let new_approach = new.normal_approach(model);
+        let electric_work = match (old.potential, new.potential) {
+            (Some(a), Some(b)) => 0.5 * (a + b) * (new.charge - old.charge),
+            _ => 0.0,
+        };
+        Self {
+            displacement,
+            dissipation,
+            normal_work: new.normal_load * (new_approach - old_approach),
+            electric_work,
+            new_ux,
+            new_approach,
+        }
+    }
+}
+
+impl SolvedStep {
+    /// The inputs of this step's increments, with what the driver already knows of the old
+    /// state (call after the previous step is finished).
+    pub fn increment_inputs(&self, driver: &DriverState) -> IncrementInputs {
+        IncrementInputs {
+            old: self.old.clone(),
+            new: self.new.clone(),
+            anchor: self.anchor,
+            old_ux: driver
+                .anchor_ux
+                .filter(|(x, _)| x.to_bits() == self.anchor.to_bits())
+                .map(|(_, u)| u),
+            old_approach: driver.approach,
+        }
+    }
+}
+
+/// The record of a hold step (nothing changes), passed to the observer.
+fn hold_record(
+    driver: &DriverState,
+    point: LoadPoint,
+    regime: Regime,
+    observer: &mut dyn Observer,
+) -> StepRecord {
+    let mut rec = record(point.step, point.t, driver, regime, None);
+    rec.q = point.q;
+    observer.on_step(&rec, &driver.state);
+    rec
+}
+
+/// Commit a solved step's increments to the driver (δ, the anchor's ux, δn) and pass its
+/// record to the observer (after the phase it begins, if any). Steps must be finished in
+/// order.
+pub fn finish_step(
+    driver: &mut DriverState,
+    solved: SolvedStep,
+    increments: StepIncrements,
+    observer: &mut dyn Observer,
+) -> StepRecord {
+    driver.anchor_ux = Some((solved.anchor, increments.new_ux));
+    driver.approach = Some(increments.new_approach);
+    driver.displacement += increments.displacement;
+    let mut rec = solved.record;
+    rec.displacement = driver.displacement;
+    rec.dissipation = increments.dissipation;
+    rec.normal_work = increments.normal_work;
+    rec.electric_work = increments.electric_work;
+    if let Some((phase, memory)) = &solved.new_phase {
+        observer.on_phase(*phase, memory);
+    }
+    observer.on_step(&rec, &solved.new);
+    rec
+}
+
+/// Solve one load step and commit its state to the driver (phase, memory, anchor, warm
+/// start); its increments are left to [`finish_step`].
+pub fn solve_step(
+    model: &ContactModel,
+    disc: &Discretisation,
+    driver: &mut DriverState,
+    point: LoadPoint,
+    options: SlipOptions,
+) -> Result<Solved, StepFailure> {
     let LoadPoint { step, t, q } = point;
     let dq = q - driver.state.tangential_load;
     let regime = next_regime(dq, 1e-12 * model.friction * driver.state.normal_load);
     let Some(sign) = regime.slip_sign() else {
-        // Hold: nothing changes.
-        driver.last_dissipation = 0.0;
-        driver.last_normal_work = 0.0;
-        driver.last_electric_work = 0.0;
-        let mut rec = record(step, t, driver, regime, None);
-        rec.q = q;
-        observer.on_step(&rec, &driver.state);
-        return Ok(rec);
+        return Ok(Solved::Hold(regime));
     };
     let new_phase = driver.phase_sign != Some(sign);
     let guess = if new_phase {
@@ -457,7 +597,6 @@ pub fn advance(
         driver.memory = memory;
         driver.base = base;
         driver.history.clear();
-        observer.on_phase(driver.phase, &driver.memory);
     }
     // Keep the anchor of δ while it sticks; otherwise take the middle of the part of the old
     // stick zone that still sticks.
@@ -478,27 +617,6 @@ pub fn advance(
             new_zone.mid()
         };
     }
-    let old_ux = driver
-        .anchor_ux
-        .filter(|(x, _)| x.to_bits() == driver.anchor.to_bits())
-        .map(|(_, u)| u);
-    let (d_delta, dissipation, new_ux) =
-        step_increments(model, &driver.state, &solved.state, driver.anchor, old_ux);
-    driver.anchor_ux = Some((driver.anchor, new_ux));
-    driver.displacement += d_delta;
-    driver.last_dissipation = dissipation;
-    let old = &driver.state;
-    let new = &solved.state;
-    let old_approach = driver
-        .approach
-        .unwrap_or_else(|| old.normal_approach(model));
-    let new_approach = new.normal_approach(model);
-    driver.approach = Some(new_approach);
-    driver.last_normal_work = new.normal_load * (new_approach - old_approach);
-    driver.last_electric_work = match (old.potential, new.potential) {
-        (Some(a), Some(b)) => 0.5 * (a + b) * (new.charge - old.charge),
-        _ => 0.0,
-    };
     driver.warm = Some(WarmStart {
         signs: (
             solved.state.traction.left_sign,
@@ -506,7 +624,7 @@ pub fn advance(
         ),
         jacobian: solved.jacobian,
     });
-    driver.state = solved.state.clone();
+    let old = std::mem::replace(&mut driver.state, solved.state.clone());
     let stick = driver
         .state
         .traction
@@ -517,11 +635,17 @@ pub fn advance(
     if driver.history.len() > 2 {
         driver.history.remove(0);
     }
-    let rec = record(step, t, driver, regime, Some(&solved));
-    observer.on_step(&rec, &driver.state);
-    Ok(rec)
+    Ok(Solved::Slip(Box::new(SolvedStep {
+        record: record(step, t, driver, regime, Some(&solved)),
+        old,
+        new: solved.state,
+        anchor: driver.anchor,
+        new_phase: new_phase.then(|| (driver.phase, driver.memory.clone())),
+    })))
 }
 
+/// The record of the driver's committed state, with zero increments (a hold's; a slip step's
+/// are filled in by [`finish_step`]).
 fn record(
     step: usize,
     t: f64,
@@ -554,9 +678,9 @@ fn record(
         residual: solved.map_or(0.0, |x| x.residual),
         admissibility: solved.map_or_else(StepAdmissibility::default, |x| x.admissibility),
         displacement: driver.displacement,
-        dissipation: driver.last_dissipation,
-        normal_work: driver.last_normal_work,
-        electric_work: driver.last_electric_work,
+        dissipation: 0.0,
+        normal_work: 0.0,
+        electric_work: 0.0,
     }
 }
 
@@ -673,26 +797,50 @@ pub fn run_history(
         }
     }
     steps.extend(history.steps().into_iter().map(|(_, t, q)| (t, q)));
-    for (i, (t, q)) in steps.into_iter().enumerate() {
-        match advance(
-            model,
-            disc,
-            &mut driver,
-            LoadPoint { step: i + 1, t, q },
-            options,
-            observer,
-        ) {
-            Ok(rec) => records.push(rec),
-            Err(failure) => {
-                return Err(Box::new(HistoryFailure {
-                    records,
-                    driver,
-                    failure,
-                }));
+    // Pipelined on two threads: a step's increments (δ, dissipation, δn: a third of the work
+    // of a step) need only its two states, so they are computed while the next step is
+    // solved; steps are finished in order, so records, δ and the observer's calls are those
+    // of the sequential `advance`.
+    let failure = std::thread::scope(|scope| {
+        let mut pending: Option<(Box<SolvedStep>, std::thread::ScopedJoinHandle<'_, _>)> = None;
+        let finish = |pending: Option<(Box<SolvedStep>, std::thread::ScopedJoinHandle<'_, _>)>,
+                      driver: &mut DriverState,
+                      records: &mut Vec<StepRecord>,
+                      observer: &mut dyn Observer| {
+            if let Some((solved, handle)) = pending {
+                let increments = handle
+                    .join()
+                    .expect("the increments of a step do not panic");
+                records.push(finish_step(driver, *solved, increments, observer));
+            }
+        };
+        for (i, (t, q)) in steps.into_iter().enumerate() {
+            let point = LoadPoint { step: i + 1, t, q };
+            let solved = solve_step(model, disc, &mut driver, point, options);
+            finish(pending.take(), &mut driver, &mut records, observer);
+            match solved {
+                Ok(Solved::Hold(regime)) => {
+                    records.push(hold_record(&driver, point, regime, observer));
+                }
+                Ok(Solved::Slip(solved)) => {
+                    let inputs = solved.increment_inputs(&driver);
+                    let handle = scope.spawn(move || StepIncrements::compute(model, &inputs));
+                    pending = Some((solved, handle));
+                }
+                Err(failure) => return Some(failure),
             }
         }
+        finish(pending.take(), &mut driver, &mut records, observer);
+        None
+    });
+    match failure {
+        None => Ok(HistoryRun { records, driver }),
+        Some(failure) => Err(Box::new(HistoryFailure {
+            records,
+            driver,
+            failure,
+        })),
     }
-    Ok(HistoryRun { records, driver })
 }
 
 #[cfg(test)]

@@ -1200,3 +1200,58 @@ fn contact_quadrature_resolves_the_stick_zone_kink() {
     assert!(spread < 1e-13, "reference converged: {spread:e}");
     assert!(error < 1e-10, "{error:e}");
 }
+
+/// `run_history` computes each step's increments on a second thread while it solves the next
+/// step: its records (δ, dissipation, works, in order) must be those of stepping the driver
+/// with the sequential `advance`, through a reversal and a hold.
+#[test]
+fn pipelined_history_matches_sequential_steps() {
+    use fretsim::contact::tangential::SlipOptions;
+    use fretsim::history::{DriverState, LoadHistory, LoadPoint, NoObserver, advance, run_history};
+    let b = baseline(32);
+    let history = LoadHistory {
+        points: vec![
+            (0.0, 0.0),
+            (1.0, 0.4 * b.lim),
+            (2.0, 0.4 * b.lim),
+            (3.0, -0.2 * b.lim),
+        ],
+        steps_per_segment: 3,
+        max_step: 0.2 * b.lim,
+    };
+    let options = SlipOptions::default();
+    let run = run_history(
+        &b.model,
+        &b.disc,
+        &b.normal,
+        &history,
+        options,
+        &mut NoObserver,
+    )
+    .unwrap();
+    let mut driver = DriverState::after_normal_loading(&b.normal);
+    let sequential: Vec<_> = history
+        .steps()
+        .into_iter()
+        .enumerate()
+        .map(|(i, (_, t, q))| {
+            let point = LoadPoint { step: i + 1, t, q };
+            advance(
+                &b.model,
+                &b.disc,
+                &mut driver,
+                point,
+                options,
+                &mut NoObserver,
+            )
+            .unwrap()
+        })
+        .collect();
+    assert_eq!(run.records.len(), sequential.len() + 1);
+    assert!(sequential.iter().any(|r| r.dissipation > 0.0));
+    assert_eq!(&run.records[1..], &sequential[..]);
+    assert_eq!(
+        run.driver.displacement.to_bits(),
+        driver.displacement.to_bits()
+    );
+}
