@@ -8,7 +8,7 @@ use fretsim::contact::normal::{NormalOptions, solve_normal};
 use fretsim::contact::pressure::Discretisation;
 use fretsim::contact::tangential::SlipOptions;
 use fretsim::history::{
-    DriverState, LoadHistory, LoadPoint, NoObserver, StepRecord, advance, run_history,
+    DriverState, LoadHistory, LoadPoint, NoObserver, StepRecord, advance, run_history, solve_step,
 };
 use fretsim::scenario::{Scenario, default_scenario};
 
@@ -94,6 +94,29 @@ fn bench_step(c: &mut Criterion, name: &str, sizes: &[usize], loads: &[f64], nex
 fn steps(c: &mut Criterion) {
     // In the middle of the first forward phase.
     bench_step(c, "solve/forward_step", &SIZES, &[0.1, 0.2, 0.3], 0.35);
+    // The same step without its increments (δ, dissipation, δn), which `run_history`
+    // computes on a second thread while it solves the next step.
+    let sc = default_scenario();
+    let mut g = c.benchmark_group("solve/forward_step_state_only");
+    g.sample_size(10);
+    for m in SIZES {
+        let disc = Discretisation::new(m);
+        let driver = driver_after(&sc, &disc, &[0.1, 0.2, 0.3]);
+        let point = LoadPoint {
+            step: 4,
+            t: 4.0,
+            q: 0.35 * sc.model.friction * sc.normal_load,
+        };
+        g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
+            b.iter(|| {
+                let mut d = driver.clone();
+                black_box(
+                    solve_step(&sc.model, &disc, &mut d, point, SlipOptions::default()).is_ok(),
+                )
+            })
+        });
+    }
+    g.finish();
 }
 
 fn reversal(c: &mut Criterion) {

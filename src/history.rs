@@ -17,6 +17,12 @@
 //! checked, and only then committed (trial, then commit). A failure stops the run with the
 //! step, t, Q and regime; the steps already solved are kept by the caller (observer).
 //!
+//! A step's increments — Δδ at the anchor, the frictional dissipation and the works of P and
+//! of the electric load ([`step_increments`], [`StepIncrements`]) — need only the step's two
+//! states, and the next step needs none of them, so [`run_history`] computes them on a second
+//! thread while it solves the next step ([`solve_step`], then [`finish_step`] in order);
+//! [`advance`] does the same sequentially. The records are the same either way.
+//!
 //! # Warm start
 //! Inside a phase the stick-zone ends are extrapolated linearly from the last two steps. At the
 //! start of a phase the zones that already slip in the new direction keep slipping and the

@@ -488,8 +488,9 @@ impl StickZone {
         }
     }
 
-    /// Tabulate `H'q̃` (see [`CauchyTable`]) for a zone that will be evaluated many times (a
-    /// stored state's), with `nodes` Chebyshev points per piece. No-op if already done.
+    /// Tabulate `H'q̃` (see `CauchyTable`) for a zone that will be evaluated many times (one
+    /// that a phase inherits from), with `nodes` Chebyshev points per piece. No-op if already
+    /// done.
     pub fn tabulate_cauchy(&self, nodes: usize) {
         self.cauchy_table.0.get_or_init(|| {
             let width = self.hi - self.lo;
@@ -922,7 +923,7 @@ pub struct GradedTable {
 }
 
 /// `∫ f` from the smallest to the largest of `points`, split at every point with the pieces
-/// balanced (none more than three times as long as a neighbour, [`piece_ends`]), each piece
+/// balanced (none more than three times as long as a neighbour, `piece_ends`), each piece
 /// by a 32-node sine-graded Gauss–Legendre rule (nodes clustered like Chebyshev points at both
 /// ends, which absorbs square-root and logarithmic behaviour there: every point where f is
 /// not smooth must be among `points`).
