@@ -728,7 +728,8 @@ pub fn step_increments(
     // first steps after a reversal, where it is small); with them, and with the pieces
     // balanced (`graded_cumulative` halves a piece that is more than three times as long as
     // a neighbour, so that no singular point sits just outside a long piece), the rule of
-    // `field_rule_nodes` agrees with four times its nodes to 3e−8 at every step, M = 64 … 512.
+    // `slip_zone_rule_nodes` agrees with four times its nodes to 5e−9 at every step,
+    // M = 64 … 512.
     // (Unbalanced, one step, 0.048a of slip zone next to a 0.003a piece, was off by 4e−4 of
     // itself even with 96 nodes.)
     let breaks = crate::contact::step_breakpoints(old, new);
@@ -741,7 +742,7 @@ pub fn step_increments(
             .filter(|x| *x > from && *x < to)
             .collect();
         pts.extend([from, to]);
-        let nodes = crate::contact::field_rule_nodes(new.pressure.beta.len());
+        let nodes = crate::contact::slip_zone_rule_nodes(new.pressure.beta.len());
         crate::contact::graded_cumulative(pts, nodes, &q_mean)
     };
     // Right zone: −∫_{hi}^{R} Δε(t) ∫_t^R q̄; left zone: +∫_{L}^{lo} Δε(t) ∫_L^t q̄.

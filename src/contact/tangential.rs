@@ -1134,9 +1134,9 @@ pub fn assess_step(
     // from the stick end, by graded quadrature split at every point where either state is not
     // smooth ([`super::step_breakpoints`]), up to the inner of the two contact ends (points
     // that enter or leave the contact have no slip increment). Half the nodes of
-    // `field_rule_nodes` per balanced piece give the slips to 2e−8 of the largest (measured
-    // over the default history at M = 64 … 512 against four times the nodes), far inside the
-    // check's tolerance of 1e−2.
+    // `slip_zone_rule_nodes` per balanced piece give the slips to 1.2e−6 of the largest
+    // (measured over the default history at M = 64 … 512 against four times the nodes), far
+    // inside the check's tolerance of 1e−2.
     let d_strain = |s: f64| new.strain_at(model, s) - old.strain_at(model, s);
     let breaks = super::step_breakpoints(old, new);
     let mut slips = Vec::new();
@@ -1165,7 +1165,7 @@ pub fn assess_step(
             .collect();
         pts.extend(&samples);
         pts.extend([left, right]);
-        let nodes = super::field_rule_nodes(new.pressure.beta.len()) / 2;
+        let nodes = super::slip_zone_rule_nodes(new.pressure.beta.len()) / 2;
         let table = super::graded_cumulative(pts, nodes, &d_strain);
         for x in samples {
             // ∫ from `left` to x: the nodes of the pieces before x (x is a piece end).
