@@ -543,6 +543,12 @@ pub fn solve_step(
             [] => phase_start_guess(model, &driver.state, sign, dq),
         }
     };
+    if new_phase && let Some(zone) = driver.state.traction.stick.as_ref() {
+        // The turning state is about to be cloned into the memory and into the new phase's
+        // base, and both are evaluated at every residual evaluation of the phase: tabulate its
+        // H'q̃ first, so that the clones share one table (`StickZone::tabulate_cauchy`).
+        zone.tabulate_cauchy(disc.nodes() + 32);
+    }
     let memory = if new_phase {
         match (&driver.phase_sign, driver.state.traction.stick.as_ref()) {
             (None, _) => driver.memory.clone(),
