@@ -64,6 +64,33 @@ fn baseline(m: usize) -> Baseline {
     }
 }
 
+/// The state after ramping Q from 0 to `fraction` ηP in steps of 0.1 ηP (at least
+/// `steps_per_segment`) from the end of normal loading.
+fn ramped_state(
+    b: &Baseline,
+    fraction: f64,
+    steps_per_segment: usize,
+) -> fretsim::contact::ContactState {
+    use fretsim::contact::tangential::SlipOptions;
+    use fretsim::history::{LoadHistory, NoObserver, run_history};
+    let history = LoadHistory {
+        points: vec![(0.0, 0.0), (1.0, fraction * b.lim)],
+        steps_per_segment,
+        max_step: 0.1 * b.lim,
+    };
+    run_history(
+        &b.model,
+        &b.disc,
+        &b.normal,
+        &history,
+        SlipOptions::default(),
+        &mut NoObserver,
+    )
+    .unwrap()
+    .driver
+    .state
+}
+
 /// The step records of a load history (points `(t, Q)`) run from the end of normal loading.
 fn step_records(
     model: &ContactModel,
@@ -1136,24 +1163,9 @@ fn steady_cycle_mirror_mismatch_vanishes_with_beta() {
 #[test]
 fn contact_quadrature_resolves_the_stick_zone_kink() {
     use fretsim::contact::normal::arcsine_moment;
-    use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{LoadHistory, NoObserver, run_history};
     let base = baseline(64);
-    let history = LoadHistory {
-        points: vec![(0.0, 0.0), (1.0, 0.3 * base.lim)],
-        steps_per_segment: 1,
-        max_step: 0.1 * base.lim,
-    };
-    let run = run_history(
-        &base.model,
-        &base.disc,
-        &base.normal,
-        &history,
-        SlipOptions::default(),
-        &mut NoObserver,
-    )
-    .unwrap();
-    let s = &run.driver.state;
+    let state = ramped_state(&base, 0.3, 1);
+    let s = &state;
     let zone = s.traction.stick.as_ref().unwrap();
     let (c, a) = (s.centre, s.half_width);
     let mut points = vec![c - a, c + a, zone.lo, zone.hi, 0.0];
@@ -1267,24 +1279,9 @@ fn pipelined_history_matches_sequential_steps() {
 /// between 400, 800 and 1600 nodes; a fixed 32-node rule 3.0e−7. The bound is 1e−10.
 #[test]
 fn surface_displacement_quadrature_scales_with_m() {
-    use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{LoadHistory, NoObserver, run_history};
     let base = baseline(256);
-    let history = LoadHistory {
-        points: vec![(0.0, 0.0), (1.0, 0.3 * base.lim)],
-        steps_per_segment: 3,
-        max_step: 0.1 * base.lim,
-    };
-    let run = run_history(
-        &base.model,
-        &base.disc,
-        &base.normal,
-        &history,
-        SlipOptions::default(),
-        &mut NoObserver,
-    )
-    .unwrap();
-    let (model, s) = (&base.model, &run.driver.state);
+    let state = ramped_state(&base, 0.3, 3);
+    let (model, s) = (&base.model, &state);
     let zone = s.traction.stick.as_ref().unwrap();
     let x = zone.lo + 0.37 * (zone.hi - zone.lo);
     let (c, a) = (s.centre, s.half_width);
