@@ -815,19 +815,24 @@ pub fn run_history(
     // of a step) need only its two states, so they are computed while the next step is
     // solved; steps are finished in order, so records, δ and the observer's calls are those
     // of the sequential `advance`.
+    /// A solved step and the thread computing its increments.
+    type Pending<'scope> = Option<(
+        Box<SolvedStep>,
+        std::thread::ScopedJoinHandle<'scope, StepIncrements>,
+    )>;
+    let finish = |pending: Pending<'_>,
+                  driver: &mut DriverState,
+                  records: &mut Vec<StepRecord>,
+                  observer: &mut dyn Observer| {
+        if let Some((solved, handle)) = pending {
+            let increments = handle
+                .join()
+                .expect("the increments of a step do not panic");
+            records.push(finish_step(driver, *solved, increments, observer));
+        }
+    };
     let failure = std::thread::scope(|scope| {
-        let mut pending: Option<(Box<SolvedStep>, std::thread::ScopedJoinHandle<'_, _>)> = None;
-        let finish = |pending: Option<(Box<SolvedStep>, std::thread::ScopedJoinHandle<'_, _>)>,
-                      driver: &mut DriverState,
-                      records: &mut Vec<StepRecord>,
-                      observer: &mut dyn Observer| {
-            if let Some((solved, handle)) = pending {
-                let increments = handle
-                    .join()
-                    .expect("the increments of a step do not panic");
-                records.push(finish_step(driver, *solved, increments, observer));
-            }
-        };
+        let mut pending: Pending<'_> = None;
         for (i, (t, q)) in steps.into_iter().enumerate() {
             let point = LoadPoint { step: i + 1, t, q };
             let solved = solve_step(model, disc, &mut driver, point, options);
