@@ -1347,6 +1347,53 @@ mod tests {
     }
 
     #[test]
+    fn inherited_corrections_vanish_outside_the_new_zone() {
+        // `correction_at` returns zero outside its zone without walking the chain; that is
+        // exact only if every link `inheritance_for` builds is zero there: a link carried
+        // whole lies inside the new zone, a faded one has χ = 0 beyond the new zone's ends.
+        let series = BoundedSeries {
+            beta: (1..=16).map(|k| 1.0 / (k * k) as f64).collect(),
+        };
+        let old = std::sync::Arc::new(StickZone::new(-0.9, 0.9, series.clone(), -0.3));
+        let inner = std::sync::Arc::new(StickZone {
+            inherited: old.inheritance_for(-0.7, 0.5),
+            ..StickZone::new(-0.7, 0.5, series, 0.0)
+        });
+        // New zones inside, across either end, and around the older zones.
+        let cases = [
+            (-0.6, 0.4),
+            (-0.8, 0.2),
+            (-0.2, 0.7),
+            (-0.95, 0.95),
+            (-0.5, 0.45),
+        ];
+        let mut links = 0;
+        for base in [&old, &inner] {
+            for (lo, hi) in cases {
+                let Some(link) = base.inheritance_for(lo, hi) else {
+                    continue;
+                };
+                links += 1;
+                for i in 0..=400 {
+                    let x = -1.2 + 2.4 * i as f64 / 400.0;
+                    if x > lo && x < hi {
+                        continue;
+                    }
+                    let outside_link = !(x > link.zone.lo && x < link.zone.hi);
+                    assert!(
+                        outside_link || link.chi(x).abs() <= 0.0,
+                        "zone [{lo}, {hi}], link [{}, {}]: χ({x}) = {}",
+                        link.zone.lo,
+                        link.zone.hi,
+                        link.chi(x)
+                    );
+                }
+            }
+        }
+        assert!(links >= 8, "{links} links built");
+    }
+
+    #[test]
     fn piece_ends_keep_every_point_and_balance_neighbours() {
         // A long piece next to a short one (a stick end 0.003 beyond a ramp end) is halved
         // until no piece is more than three times as long as a neighbour.
