@@ -479,6 +479,7 @@ impl InnerMaps {
                 }
             }
         }
+        let stick_shape: Vec<f64> = stick_points.iter().map(|&x| state.slip_shape(x)).collect();
         let (mid, half) = (stick.mid(), stick.half());
         let mut own_at_samples = RowMatrix::zeros(sample_points.len(), m);
         for (j, &xq) in sample_points.iter().enumerate() {
@@ -491,8 +492,7 @@ impl InnerMaps {
                 BoundedSeries::density_row((t - c) / a, at_nodes.row_mut(j));
             }
             let mut weights = RowMatrix::zeros(rows, table.len());
-            for (i, &xs) in stick_points.iter().enumerate() {
-                let sx = state.slip_shape(xs);
+            for (i, (&xs, &sx)) in stick_points.iter().zip(&stick_shape).enumerate() {
                 for (wij, &(t, w, st)) in weights.row_mut(i).iter_mut().zip(&table) {
                     if (t - xs).abs() > 1e-14 * a {
                         *wij = w * (st - sx) / (t - xs) / std::f64::consts::PI;
@@ -510,7 +510,7 @@ impl InnerMaps {
             cauchy_at_stick,
             shape_nodes,
             shape_weights,
-            stick_shape: stick_points.iter().map(|&x| state.slip_shape(x)).collect(),
+            stick_shape,
         }
     }
 }
@@ -649,17 +649,6 @@ pub fn solve_slip(
     options: SlipOptions,
 ) -> Result<SlipStep, SolveFailure> {
     let guess = guesses_in[0];
-    // Every evaluation of the phase walks the base chain's `H'q̃`: tabulate it (once per
-    // zone). A zone accepted in the middle of a phase is evaluated only by the next step's
-    // checks and increments, too few times to pay for a table (default run: tabulating every
-    // accepted zone 1.81 s, the base chains only 1.60 s, δ and the stick ends the same to
-    // 1e−13 of themselves).
-    if let Some(base) = base {
-        base.tabulate_cauchy(disc.nodes() + 32);
-        for link in base.links() {
-            link.zone.tabulate_cauchy(disc.nodes() + 32);
-        }
-    }
     // Both slip zones normally follow the load (seed Section 4); right after a reversal in a
     // coupled contact one edge may keep its previous direction while the contact shifts, so
     // the mixed states are tried when the standard one has no solution.

@@ -64,42 +64,16 @@ fn baseline(m: usize) -> Baseline {
     }
 }
 
-/// The state after ramping Q from 0 to `fraction` ηP in steps of 0.1 ηP (at least
-/// `steps_per_segment`) from the end of normal loading.
-fn ramped_state(
-    b: &Baseline,
-    fraction: f64,
-    steps_per_segment: usize,
-) -> fretsim::contact::ContactState {
-    use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{LoadHistory, NoObserver, run_history};
-    let history = LoadHistory {
-        points: vec![(0.0, 0.0), (1.0, fraction * b.lim)],
-        steps_per_segment,
-        max_step: 0.1 * b.lim,
-    };
-    run_history(
-        &b.model,
-        &b.disc,
-        &b.normal,
-        &history,
-        SlipOptions::default(),
-        &mut NoObserver,
-    )
-    .unwrap()
-    .driver
-    .state
-}
-
-/// The step records of a load history (points `(t, Q)`) run from the end of normal loading.
-fn step_records(
+/// A load history (points `(t, Q)`) run from the end of normal loading (its step records and
+/// final driver state).
+fn run_points(
     model: &ContactModel,
     disc: &Discretisation,
     normal: &fretsim::contact::normal::NormalLoading,
     points: Vec<(f64, f64)>,
     steps_per_segment: usize,
     max_step: f64,
-) -> Vec<fretsim::history::StepRecord> {
+) -> fretsim::history::HistoryRun {
     use fretsim::contact::tangential::SlipOptions;
     use fretsim::history::{LoadHistory, NoObserver, run_history};
     let history = LoadHistory {
@@ -116,7 +90,26 @@ fn step_records(
         &mut NoObserver,
     )
     .unwrap()
-    .records
+}
+
+/// The state after ramping Q from 0 to `fraction` ηP in steps of 0.1 ηP (at least
+/// `steps_per_segment`) from the end of normal loading.
+fn ramped_state(
+    b: &Baseline,
+    fraction: f64,
+    steps_per_segment: usize,
+) -> fretsim::contact::ContactState {
+    let points = vec![(0.0, 0.0), (1.0, fraction * b.lim)];
+    run_points(
+        &b.model,
+        &b.disc,
+        &b.normal,
+        points,
+        steps_per_segment,
+        0.1 * b.lim,
+    )
+    .driver
+    .state
 }
 
 #[test]
@@ -675,8 +668,6 @@ fn normal_loading_converges_in_m() {
 /// (s = +1 at both ends), i.e. within 3 % of ±γ; the bound is 10 %.
 #[test]
 fn sliding_ends_carry_the_dissimilar_contact_exponent() {
-    use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{DriverState, LoadPoint, NoObserver, advance};
     let b = baseline(256);
     let split = b.model.charge_split(2000.0);
     let ratio = b.model.pressure_shear_coupling(split) / b.model.pressure_compliance(split);
@@ -700,24 +691,7 @@ fn sliding_ends_carry_the_dissimilar_contact_exponent() {
         }
     };
     check(&b.normal.state, "normal loading");
-    let mut driver = DriverState::after_normal_loading(&b.normal);
-    for (i, f) in [0.1, 0.2, 0.3].iter().enumerate() {
-        let point = LoadPoint {
-            step: i + 1,
-            t: i as f64,
-            q: f * b.lim,
-        };
-        advance(
-            &b.model,
-            &b.disc,
-            &mut driver,
-            point,
-            SlipOptions::default(),
-            &mut NoObserver,
-        )
-        .unwrap();
-    }
-    check(&driver.state, "Q = 0.3 ηP");
+    check(&ramped_state(&b, 0.3, 3), "Q = 0.3 ηP");
 }
 
 /// Each return to a remembered turning state inherits that state whole and adds nothing of its
@@ -727,8 +701,7 @@ fn sliding_ends_carry_the_dissimilar_contact_exponent() {
 /// chains were collapsed, one link was added per cycle).
 #[test]
 fn inherited_chains_stop_growing_in_steady_cycles() {
-    use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{LoadHistory, NoObserver, run_history};
+    use fretsim::history::LoadHistory;
     let b = baseline(32);
     let end_of = |repeats: usize| {
         let points = LoadHistory::with_cycles(
@@ -736,21 +709,9 @@ fn inherited_chains_stop_growing_in_steady_cycles() {
             &[(2.0, -0.5 * b.lim), (4.0, 0.5 * b.lim)],
             repeats,
         );
-        let history = LoadHistory {
-            points,
-            steps_per_segment: 1,
-            max_step: 0.1 * b.lim,
-        };
-        let run = run_history(
-            &b.model,
-            &b.disc,
-            &b.normal,
-            &history,
-            SlipOptions::default(),
-            &mut NoObserver,
-        )
-        .unwrap();
-        run.driver.state
+        run_points(&b.model, &b.disc, &b.normal, points, 1, 0.1 * b.lim)
+            .driver
+            .state
     };
     let (three, six) = (end_of(3), end_of(6));
     let zone = |s: &fretsim::contact::ContactState| s.traction.stick.clone().unwrap();
@@ -786,7 +747,7 @@ fn reference_fretting_loop_uncoupled() {
             (2.0, -0.5 * lim),
             (3.0, 0.5 * lim),
         ];
-        let recs = step_records(&model, &disc, &normal, points, 40, lim);
+        let recs = run_points(&model, &disc, &normal, points, 40, lim).records;
         let scale = y11 * lim / std::f64::consts::PI;
         let mut worst = 0.0f64;
         for r in &recs[1..] {
@@ -848,7 +809,7 @@ fn cycle_verdicts() {
         for (i, a) in amps.iter().enumerate() {
             pts.push((pts.len() as f64, if i % 2 == 0 { *a } else { -*a } * lim));
         }
-        step_records(&model, &disc, &normal, pts, 10, lim)
+        run_points(&model, &disc, &normal, pts, 10, lim).records
     };
     let steady = run(&[0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5]);
     let (cycles, verdict) = analyse_cycles(&steady, 1e-6);
@@ -887,7 +848,7 @@ fn history_is_mirror_symmetric() {
             (3.0, -0.5 * s * lim),
             (5.0, 0.5 * s * lim),
         ];
-        step_records(&model, &disc, &normal, points, 10, 0.05 * lim)
+        run_points(&model, &disc, &normal, points, 10, 0.05 * lim).records
     };
     let (plus, minus) = (run(1.0), run(-1.0));
     assert_eq!(plus.len(), 51, "{}", plus.len());
@@ -993,7 +954,7 @@ fn coupled_cycle_masing_return_and_step_refinement() {
     for b in &runs {
         let m = b.disc.nodes();
         let a = b.normal.state.half_width;
-        let recs = step_records(&b.model, &b.disc, &b.normal, points.clone(), 10, 0.05 * lim);
+        let recs = run_points(&b.model, &b.disc, &b.normal, points.clone(), 10, 0.05 * lim).records;
         assert_eq!(recs.len(), 71);
         assert_zones_inside_and_monotone(&recs, a);
         let t = turning(&recs);
@@ -1025,7 +986,7 @@ fn coupled_cycle_masing_return_and_step_refinement() {
     }
     // Step refinement at M = 64.
     let b = &runs[1];
-    let fine = step_records(&b.model, &b.disc, &b.normal, points, 10, 0.025 * lim);
+    let fine = run_points(&b.model, &b.disc, &b.normal, points, 10, 0.025 * lim).records;
     assert_eq!(fine.len(), 141);
     let (tf, tc) = (turning(&fine), turning(recs64));
     let range = tc[0].displacement - tc[1].displacement;
@@ -1069,7 +1030,7 @@ fn coupled_partial_unload_reload_follows_masing() {
             .enumerate()
             .map(|(i, f)| (i as f64, f * lim))
             .collect();
-        step_records(&model, &disc, &normal, points, 5, 0.1 * lim)
+        run_points(&model, &disc, &normal, points, 5, 0.1 * lim).records
     };
     let cycled = path(&[0.0, 0.5, 0.1, 0.5, 0.7]);
     let monotonic = path(&[0.0, 0.7]);
@@ -1126,7 +1087,7 @@ fn steady_cycle_mirror_mismatch_vanishes_with_beta() {
             (5.0, 0.5 * lim),
             (7.0, -0.5 * lim),
         ];
-        let recs = step_records(&model, &disc, &normal, points, 10, 0.05 * lim);
+        let recs = run_points(&model, &disc, &normal, points, 10, 0.05 * lim).records;
         assert_zones_inside_and_monotone(&recs, normal.state.half_width);
         let (plus, minus) = (&recs[50], &recs[70]);
         assert!(
