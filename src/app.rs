@@ -124,7 +124,7 @@ pub fn field_points(centre: f64, half_width: f64, count: usize) -> Vec<f64> {
 
 fn normal_summary(model: &ContactModel, n: &NormalLoading) -> NormalSummary {
     let s = &n.state;
-    let w_total = s.potential_charge.integral() * s.half_width;
+    let w_total = s.potential_charge_force();
     NormalSummary {
         half_width: s.half_width,
         eccentricity: -s.centre,
@@ -134,9 +134,9 @@ fn normal_summary(model: &ContactModel, n: &NormalLoading) -> NormalSummary {
         peak_pressure: s.pressure_at(s.centre),
         charge: s.charge,
         potential: s.potential,
-        pressure_resultant: s.pressure.integral() * s.half_width,
+        pressure_resultant: s.pressure_force(),
         // The inverse-square-root part integrates exactly from its series; the rest by quadrature.
-        charge_resultant: s.split.ratio * s.pressure.integral() * s.half_width + w_total,
+        charge_resultant: s.split.ratio * s.pressure_force() + w_total,
         iterations: n.iterations,
         admissibility: n.admissibility,
         outside_gap: model.outside_gap(s),

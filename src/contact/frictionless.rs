@@ -9,7 +9,7 @@ use crate::quadrature::UnboundedSeries;
 use super::pressure::{
     Discretisation, electric_resultants, solve_potential_charge, solve_pressure,
 };
-use super::{ContactModel, ContactState, Traction};
+use super::{ContactModel, ContactState, Kinks, Traction};
 
 /// Solve frictionless normal contact under load P (N/m) with the model's electrode.
 pub fn solve_frictionless(
@@ -44,8 +44,10 @@ pub fn solve_frictionless(
         half_width: a,
         centre: pressure.centre,
         pressure: pressure.pressure,
+        pressure_kinks: Kinks::default(),
         split,
         potential_charge,
+        charge_kinks: Kinks::default(),
         traction: Traction {
             friction: 0.0,
             left_sign: 0.0,

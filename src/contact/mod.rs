@@ -230,6 +230,10 @@ pub struct StickZone {
     /// square-root structure of the memory at old stick ends (see [`Inherited`]).
     #[serde(skip)]
     pub inherited: Option<std::sync::Arc<Inherited>>,
+    /// The square-root coefficients `[k_lo, k_hi]` of the whole q̃ (own and inherited) at the
+    /// ends, `q̃ ≈ k_lo √(x − lo)` and `q̃ ≈ k_hi √(hi − x)` (Pa/√m), which fix the kinks of
+    /// p and w ([`Kinks`]); zero for a zone solved without them.
+    pub end_roots: [f64; 2],
     /// `H'q̃` tabulated once the zone begins a phase ([`StickZone::tabulate_cauchy`]).
     #[serde(skip)]
     cauchy_table: TableCache,
@@ -395,6 +399,27 @@ impl Inherited {
         }
     }
 
+    /// The square-root coefficients this link adds to q̃ at the ends `lo` and `hi` of the zone
+    /// that inherits it: the earlier zone's [`StickZone::end_roots`] where it ends at the same
+    /// point (a return to a remembered zone) without a fade, zero elsewhere (a link's q̃ is
+    /// zero beyond its zone, and a fade ramp vanishes like a fifth power).
+    pub fn end_roots(&self, lo: f64, hi: f64) -> [f64; 2] {
+        let slack = 1e-12 * (hi - lo);
+        let z = &self.zone;
+        [
+            if self.ramp_lo.is_none() && (z.lo - lo).abs() <= slack {
+                z.end_roots[0]
+            } else {
+                0.0
+            },
+            if self.ramp_hi.is_none() && (z.hi - hi).abs() <= slack {
+                z.end_roots[1]
+            } else {
+                0.0
+            },
+        ]
+    }
+
     /// Breakpoints of the quadrature over the earlier zone.
     fn pieces(&self) -> Vec<f64> {
         let mut pts = vec![self.zone.lo];
@@ -484,6 +509,7 @@ impl StickZone {
             correction,
             kink,
             inherited: None,
+            end_roots: [0.0; 2],
             cauchy_table: TableCache::default(),
         }
     }
@@ -677,6 +703,47 @@ impl StickZone {
     }
 }
 
+/// Amplitudes of the square-root kinks of a density (the pressure p or the charge w) at the
+/// stick ends: the density is `series + (left·e(x; c − a, lo) + right·e(x; hi, c + a))/a`
+/// with the half-ellipse `e(x; u, v) = √((x − u)(v − x))` on `[u, v]` (zero elsewhere), which
+/// starts like a square root at the stick end on the slip side, vanishes like one at the
+/// contact end, and has a Cauchy transform in closed form ([`half_ellipse_cauchy`]). Zero
+/// unless the density is coupled to the stick traction; see the tangential module docs
+/// ("Kinks at the stick ends") for where the kinks come from and how the amplitudes are fixed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct Kinks {
+    /// Amplitude on the left slip zone (the density's unit).
+    pub left: f64,
+    /// Amplitude on the right slip zone.
+    pub right: f64,
+}
+
+/// `√((x − u)(v − x))` on `[u, v]`, zero outside (m).
+pub fn half_ellipse(x: f64, u: f64, v: f64) -> f64 {
+    if x <= u || x >= v {
+        0.0
+    } else {
+        ((x - u) * (v - x)).sqrt()
+    }
+}
+
+/// `(1/π)⨍ e(t)/(t − x) dt` of [`half_ellipse`] (m): `−(x − m)` on `[u, v]` and
+/// `−(x − m) + sgn(x − m)√((x − u)(x − v))` outside, `m = (u + v)/2` (the n = 1 term of a
+/// bounded series, `−h T_1` inside and `−h z` outside; it decays like `−h²/(2(x − m))`).
+pub fn half_ellipse_cauchy(x: f64, u: f64, v: f64) -> f64 {
+    let m = 0.5 * (u + v);
+    if x >= u && x <= v {
+        -(x - m)
+    } else {
+        -(x - m) + (x - m).signum() * ((x - u) * (x - v)).sqrt()
+    }
+}
+
+/// `∫ e dx = π (v − u)²/8` of [`half_ellipse`] (m²).
+pub fn half_ellipse_integral(u: f64, v: f64) -> f64 {
+    std::f64::consts::PI * (v - u) * (v - u) / 8.0
+}
+
 /// The solution at one instant.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ContactState {
@@ -692,12 +759,17 @@ pub struct ContactState {
     pub half_width: f64,
     /// Contact centre c in the material frame (m); eccentricity e = −c.
     pub centre: f64,
-    /// Pressure on the contact, `p(x) = density((x − c)/a)` (Pa).
+    /// Pressure on the contact, `p(x) = density((x − c)/a) + kinks` (Pa): the series part.
     pub pressure: BoundedSeries,
+    /// The pressure's square-root kinks at the stick ends ([`Kinks`]).
+    pub pressure_kinks: Kinks,
     /// Charge split.
     pub split: ChargeSplit,
-    /// Constant-potential charge `w((x − c)/a)` (C/m²); empty unless conducting.
+    /// Constant-potential charge `w(x) = density((x − c)/a) + kinks` (C/m²): the series part;
+    /// empty unless conducting.
     pub potential_charge: UnboundedSeries,
+    /// The square-root kinks of w at the stick ends ([`Kinks`]).
+    pub charge_kinks: Kinks,
     /// Shear traction.
     pub traction: Traction,
     /// Quadrature table `(t, w p(t), S(t))` of [`ContactState::shape_cauchy`] for a stored
@@ -719,12 +791,55 @@ impl ContactState {
 
     /// Pressure p(x) (Pa).
     pub fn pressure_at(&self, x: f64) -> f64 {
-        self.pressure.density(self.tau(x))
+        self.pressure.density(self.tau(x)) + self.kinks_at(&self.pressure_kinks, x)
+    }
+
+    /// The part `w` of the charge held by the constant potential (C/m²).
+    pub fn potential_charge_at(&self, x: f64) -> f64 {
+        self.potential_charge.density(self.tau(x)) + self.kinks_at(&self.charge_kinks, x)
+    }
+
+    /// The slip zones `[c − a, lo]` and `[hi, c + a]` when `kinks` has an amplitude.
+    fn kink_zones(&self, kinks: &Kinks) -> Option<[(f64, f64); 2]> {
+        if kinks.left.abs() <= 0.0 && kinks.right.abs() <= 0.0 {
+            return None;
+        }
+        let stick = self.traction.stick.as_ref()?;
+        let (c, a) = (self.centre, self.half_width);
+        Some([(c - a, stick.lo), (stick.hi, c + a)])
+    }
+
+    /// `(left e_L(x) + right e_R(x))/a` for the kink functions of [`Kinks`], or with `f` in
+    /// place of the half-ellipse (its transform or integral).
+    fn kinks_with(&self, kinks: &Kinks, f: impl Fn(f64, f64) -> f64) -> f64 {
+        match self.kink_zones(kinks) {
+            Some([left, right]) => {
+                (kinks.left * f(left.0, left.1) + kinks.right * f(right.0, right.1))
+                    / self.half_width
+            }
+            None => 0.0,
+        }
+    }
+
+    fn kinks_at(&self, kinks: &Kinks, x: f64) -> f64 {
+        self.kinks_with(kinks, |u, v| half_ellipse(x, u, v))
+    }
+
+    /// `∫ p dx` over the contact (N/m).
+    pub fn pressure_force(&self) -> f64 {
+        self.half_width * self.pressure.integral()
+            + self.kinks_with(&self.pressure_kinks, half_ellipse_integral)
+    }
+
+    /// `∫ w dx` over the contact (C/m).
+    pub fn potential_charge_force(&self) -> f64 {
+        self.half_width * self.potential_charge.integral()
+            + self.kinks_with(&self.charge_kinks, half_ellipse_integral)
     }
 
     /// Charge g(x) = χ p + w (C/m²).
     pub fn charge_at(&self, x: f64) -> f64 {
-        self.split.ratio * self.pressure_at(x) + self.potential_charge.density(self.tau(x))
+        self.split.ratio * self.pressure_at(x) + self.potential_charge_at(x)
     }
 
     /// The slip-direction function S(x): the left/right signs outside the stick zone and the
@@ -756,12 +871,14 @@ impl ContactState {
     /// `H'p(x) = (1/π)⨍ p(s)/(s − x) ds` from the representation (Pa), any x off the ends.
     pub fn pressure_cauchy(&self, x: f64) -> f64 {
         self.pressure.cauchy(self.tau(x))
+            + self.kinks_with(&self.pressure_kinks, |u, v| half_ellipse_cauchy(x, u, v))
     }
 
     /// `H'g(x)` (C/m²).
     pub fn charge_cauchy(&self, x: f64) -> f64 {
-        let t = self.tau(x);
-        self.split.ratio * self.pressure.cauchy(t) + self.potential_charge.cauchy(t)
+        self.split.ratio * self.pressure_cauchy(x)
+            + self.potential_charge.cauchy(self.tau(x))
+            + self.kinks_with(&self.charge_kinks, |u, v| half_ellipse_cauchy(x, u, v))
     }
 
     /// `H'(pS)(x) = S(x) H'p(x) + (1/π)∫ p(t)(S(t) − S(x))/(t − x) dt`: the Cauchy transform of
@@ -862,9 +979,8 @@ impl ContactState {
     /// Surface strain `∂ux/∂x` from eq. (A): `−(w12 + χ w13) p − w13 w + y11 H'q`.
     pub fn strain_at(&self, model: &ContactModel, x: f64) -> f64 {
         let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
-        let tau = self.tau(x);
         -model.local_pressure_strain(self.split) * self.pressure_at(x)
-            - w13 * self.potential_charge.density(tau)
+            - w13 * self.potential_charge_at(x)
             + model.compliance.y11 * self.traction_cauchy(x)
     }
 }
@@ -1205,10 +1321,7 @@ impl ContactState {
     pub fn surface_displacement(&self, model: &ContactModel, x: f64) -> f64 {
         let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
         let local = model.local_pressure_strain(self.split);
-        let local_density = |s: f64| {
-            let tau = (s - self.centre) / self.half_width;
-            local * self.pressure_at(s) + w13 * self.potential_charge.density(tau)
-        };
+        let local_density = |s: f64| local * self.pressure_at(s) + w13 * self.potential_charge_at(s);
         let traction = |s: f64| self.traction_at(s);
         -0.5 * self.sign_integral(x, &local_density)
             - model.compliance.y11 / std::f64::consts::PI

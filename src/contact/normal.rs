@@ -123,8 +123,7 @@ fn stick_for(
         .iter()
         .map(|t| {
             let x = b * t;
-            let tau = (x - state.centre) / state.half_width;
-            (local * state.pressure_at(x) + w13 * state.potential_charge.density(tau)
+            (local * state.pressure_at(x) + w13 * state.potential_charge_at(x)
                 - eta * y11 * state.shape_cauchy(x))
                 / y11
         })

@@ -90,7 +90,10 @@ use crate::quadrature::{BoundedSeries, RowMatrix, UnboundedSeries, dot};
 use super::memory::Memory;
 use super::normal::arcsine_moment;
 use super::pressure::{Discretisation, electric_resultants};
-use super::{ContactModel, ContactState, Inherited, StickZone};
+use super::{
+    ContactModel, ContactState, Inherited, Kinks, StickZone, half_ellipse,
+    half_ellipse_cauchy,
+};
 
 /// Options of a tangential step.
 #[derive(Debug, Clone, Copy, Serialize)]
@@ -243,7 +246,7 @@ impl StepProblem<'_> {
                 let fixed_charge = if split.conducting {
                     0.0
                 } else {
-                    w13 * guess.potential_charge.density((x - g.c) / g.a) / y11
+                    w13 * guess.potential_charge_at(x) / y11
                 };
                 self.memory.strain(model, x) / y11 - inherited.as_ref().map_or(0.0, |z| z.cauchy(x))
                     + fixed_charge
@@ -286,6 +289,12 @@ impl StepProblem<'_> {
             .chain(&charge_points[..nc])
             .copied()
             .collect();
+        let electric = split
+            .conducting
+            .then(|| model.compliance.electric)
+            .flatten();
+        let w13_over_y33 = electric.map_or(0.0, |e| e.w13 / e.y33);
+        let coupled = kappa.abs() > 0.0 || w13_over_y33.abs() > 0.0;
         let maps = InnerMaps::new(
             &state,
             &stick_points,
@@ -295,14 +304,39 @@ impl StepProblem<'_> {
                 local_over_y11: local / y11,
                 shape: (!mixed).then_some(eta * self.signs.0),
                 charge: split.conducting.then_some(w13 / y11),
+                kinks: coupled,
             },
         );
-        // The inner unknown: q at the pressure points, then at the charge points.
+        // The kinks of p and w: H' of the two half-ellipses at the pressure and charge points,
+        // and the amplitudes' relation to the end coefficients of q̃ (see `KinkRelation`).
+        let kink_cauchy_at = |points: &[f64]| -> Vec<[f64; 2]> {
+            if coupled {
+                points.iter().map(|&x| maps.kink_cauchy(x)).collect()
+            } else {
+                Vec::new()
+            }
+        };
+        let kink_cauchy_at_pressure = kink_cauchy_at(&pressure_points);
+        let kink_cauchy_at_charge = kink_cauchy_at(&charge_points[..nc.min(charge_points.len())]);
+        let relation = KinkRelation::new(g, kappa / ystar, w13_over_y33, eta, self.signs);
+        // q̃'s end coefficients are carried as `Σ (±1)ⁿ (n + 1) β_n` (Pa, the scale of q).
+        let root_scale = (2.0 / half).sqrt();
+        let inherited_ends = inherited
+            .as_ref()
+            .map_or([0.0; 2], |z| z.end_roots(g.lo, g.hi).map(|k| k / root_scale));
+        // The inner unknown: q at the pressure points, then at the charge points, then (when
+        // coupled) q̃'s end coefficients.
         let mut x: Vec<f64> = sample_points
             .iter()
             .map(|&x| guess.traction_at(x))
             .collect();
-        let mut fx = vec![0.0; np + nc];
+        if coupled {
+            let guess_zone = guess.traction.stick.as_ref();
+            x.extend(guess_zone.map_or([0.0; 2], |z| {
+                z.end_roots.map(|k| k / root_scale)
+            }));
+        }
+        let mut fx = vec![0.0; x.len()];
         let mut rhs = vec![0.0; m + 1];
         let mut beta_p = vec![0.0; m];
         let mut beta_q = vec![0.0; m];
@@ -315,13 +349,29 @@ impl StepProblem<'_> {
         let p_scale = g.a * scale;
         let (mut lambda_p, mut lambda_q) = (0.0, 0.0);
         let mut accel = Anderson::new(5);
+        let mut passes = 0;
         for _ in 0..100 {
-            // Pressure for the current shear traction (seed eqs. 52, 54, 56).
+            passes += 1;
+            // Pressure for the current shear traction (seed eqs. 52, 54, 56), less the Cauchy
+            // transform of its kinks.
+            let ends = if coupled {
+                [x[np + nc] * root_scale, x[np + nc + 1] * root_scale]
+            } else {
+                [0.0; 2]
+            };
+            let amp = relation.pressure(ends);
             for ((r, &xp), q) in rhs.iter_mut().zip(&pressure_points).zip(&x[..np]) {
                 *r = -xp * scale - kappa / ystar * q;
             }
+            for (r, h) in rhs.iter_mut().zip(&kink_cauchy_at_pressure) {
+                *r -= amp[0] * h[0] + amp[1] * h[1];
+            }
             lambda_p = disc.bounded.solve_coefficients(&rhs, &mut beta_p);
             state.pressure.beta.clone_from(&beta_p);
+            state.pressure_kinks = Kinks {
+                left: amp[0],
+                right: amp[1],
+            };
             // Charge (seed eqs. 53, 55, 41–42) for the current shear traction. The arcsine
             // moment of q fixes Γ under potential control; under charge control it only gives
             // φ0 and is evaluated once for the accepted state.
@@ -339,16 +389,31 @@ impl StepProblem<'_> {
                 state.charge = charge;
                 state.potential = potential;
                 let free = charge - model.pressure_charge(self.normal_load);
-                for (r, q) in crhs.iter_mut().zip(&x[np..]) {
+                let w_amp = relation.charge(ends);
+                state.charge_kinks = Kinks {
+                    left: w_amp[0],
+                    right: w_amp[1],
+                };
+                for (r, q) in crhs.iter_mut().zip(&x[np..np + nc]) {
                     *r = -e.w13 / e.y33 * q;
                 }
+                for (r, h) in crhs.iter_mut().zip(&kink_cauchy_at_charge) {
+                    *r -= w_amp[0] * h[0] + w_amp[1] * h[1];
+                }
+                let kinks_force = state.potential_charge_force()
+                    - g.a * state.potential_charge.integral();
                 disc.unbounded
-                    .solve_coefficients(&crhs, free / g.a, &mut gamma);
+                    .solve_coefficients(&crhs, (free - kinks_force) / g.a, &mut gamma);
                 state.potential_charge.gamma.clone_from(&gamma);
             }
             // Stick traction (seed eqs. 50–51/58–59, 60, 63); `H'(pS)` is `s H'p` when both slip
             // zones have the same sign s.
             maps.stick_from_p.apply(&beta_p, &mut srhs);
+            if let (true, Some(eta_s)) = (coupled, maps.shape) {
+                for (r, h) in srhs.iter_mut().zip(&maps.kink_cauchy_at_stick) {
+                    *r -= eta_s * (amp[0] * h[0] + amp[1] * h[1]);
+                }
+            }
             if split.conducting {
                 maps.stick_from_w.apply(&gamma, &mut work);
                 for (r, w) in srhs.iter_mut().zip(&work) {
@@ -358,6 +423,14 @@ impl StepProblem<'_> {
             if mixed {
                 maps.cauchy_at_stick.apply(&beta_p, &mut work);
                 maps.shape_nodes.apply(&beta_p, &mut p_nodes);
+                if coupled {
+                    for (w, h) in work.iter_mut().zip(&maps.kink_cauchy_at_stick) {
+                        *w += amp[0] * h[0] + amp[1] * h[1];
+                    }
+                    for (p, e) in p_nodes.iter_mut().zip(&maps.kinks_at_nodes) {
+                        *p += amp[0] * e[0] + amp[1] * e[1];
+                    }
+                }
                 for (i, r) in srhs.iter_mut().enumerate() {
                     let shape =
                         maps.stick_shape[i] * work[i] + dot(maps.shape_weights.row(i), &p_nodes);
@@ -369,27 +442,46 @@ impl StepProblem<'_> {
             }
             lambda_q = disc.bounded.solve_coefficients(&srhs, &mut beta_q);
             for (k, (shape, inh)) in fixed_p.iter().chain(&fixed_c).enumerate() {
-                let p = dot(disc.bounded_at_collocation.row(k), &beta_p);
+                let mut p = dot(disc.bounded_at_collocation.row(k), &beta_p);
+                if let Some(e) = maps.kinks_at_samples.get(k) {
+                    p += amp[0] * e[0] + amp[1] * e[1];
+                }
                 fx[k] = eta * p * shape + dot(maps.own_at_samples.row(k), &beta_q) + inh;
+            }
+            if coupled {
+                let [left, right] = end_values(&beta_q);
+                fx[np + nc] = left + inherited_ends[0];
+                fx[np + nc + 1] = right + inherited_ends[1];
             }
             if let Some(stick) = state.traction.stick.as_mut() {
                 stick.correction.beta.clone_from(&beta_q);
+                stick.end_roots = ends;
             }
             let p0 = state.pressure_at(g.c).abs().max(1e-300);
-            let change = fx
-                .iter()
-                .zip(&x)
-                .map(|(n, o)| (n - o).abs())
-                .fold(0.0, f64::max)
-                / (eta * p0);
-            if kappa == 0.0 && !split.conducting || change < 1e-14 {
+            let largest_change = |from: usize, to: usize| {
+                fx[from..to]
+                    .iter()
+                    .zip(&x[from..to])
+                    .map(|(n, o)| (n - o).abs())
+                    .fold(0.0, f64::max)
+                    / (eta * p0)
+            };
+            // q̃'s end values sum M coefficients weighted by n + 1, so their round-off grows
+            // with M (measured at M = 256: they stop changing at 3e−14 … 2e−13 of η p0).
+            let converged = largest_change(0, np + nc) < 1e-14
+                && largest_change(np + nc, x.len()) < 1e-14 * m as f64;
+            if std::env::var("KINKDBG5").is_ok() && ((g.lo - g.c) / g.a + 0.72628).abs() < 2e-5 {
+                eprintln!("pass {passes} cq {:.2e} ck {:.2e} xk {:?} fk {:?}", largest_change(0, np + nc), largest_change(np + nc, x.len()), &x[np + nc..], &fx[np + nc..]);
+            }
+            if kappa == 0.0 && !split.conducting || converged {
                 break;
             }
             accel.next(&mut x, &fx);
         }
+        if std::env::var("KINKDBG").is_ok() { eprintln!("passes {passes} Q {:.4} signs {:?} g {:.6} {:.6}", self.tangential_load, self.signs, (g.lo-g.c)/g.a, (g.hi-g.c)/g.a); }
         state.shape_table = None;
         let p0 = state.pressure_at(g.c).abs().max(1e-300);
-        let pressure_force = g.a * state.pressure.integral();
+        let pressure_force = state.pressure_force();
         let stick = state.traction.stick.as_ref().expect("set above");
         let shape_force = if (self.signs.0 - self.signs.1).abs() > 0.0 {
             // ∫ p S dx over the contact, piecewise by the graded rule.
@@ -404,6 +496,7 @@ impl StepProblem<'_> {
             lambda_q / (eta * p0),
             (q_force - self.tangential_load) / (eta * self.normal_load),
         ];
+        if std::env::var("KINKDBG4").is_ok() { eprintln!("res {:?} ends {:?} kinks {:?} {:?}", residual, state.traction.stick.as_ref().map(|s| s.end_roots), state.pressure_kinks, state.charge_kinks); }
         Ok((residual, state))
     }
 }
@@ -417,6 +510,80 @@ struct Coefficients {
     shape: Option<f64>,
     /// `w13/y11` when the charge is an unknown (conducting punch).
     charge: Option<f64>,
+    /// Whether the pressure carries kinks (κ ≠ 0).
+    kinks: bool,
+}
+
+/// The local relations that fix the amplitudes of the kinks of p and w from q̃'s behaviour at
+/// the stick ends (tangential module docs, "Kinks at the stick ends").
+struct KinkRelation {
+    /// κ/Y*.
+    kappa: f64,
+    /// w13/y33 (zero without a charge unknown).
+    charge: f64,
+    eta: f64,
+    /// `α = κηs/Y*` of the left and right slip zones.
+    alpha: [f64; 2],
+    /// `a/√L` of the left and right slip zones (length L; zero when L vanishes): the factor
+    /// from a square-root coefficient to the amplitude of a half-ellipse over a.
+    to_amplitude: [f64; 2],
+}
+
+impl KinkRelation {
+    fn new(g: &Geometry, kappa: f64, charge: f64, eta: f64, signs: (f64, f64)) -> Self {
+        let to_amplitude = |length: f64| {
+            if length > 1e-12 * g.a {
+                g.a / length.sqrt()
+            } else {
+                0.0
+            }
+        };
+        Self {
+            kappa,
+            charge,
+            eta,
+            alpha: [kappa * eta * signs.0, kappa * eta * signs.1],
+            to_amplitude: [
+                to_amplitude(g.lo - (g.c - g.a)),
+                to_amplitude(g.c + g.a - g.hi),
+            ],
+        }
+    }
+
+    /// The square-root coefficients `[A_L, A_R]` of p on the slip side of each stick end.
+    fn pressure_coefficients(&self, ends: [f64; 2]) -> [f64; 2] {
+        let side = |j: usize| self.kappa * ends[j] / (1.0 + self.alpha[j] * self.alpha[j]);
+        [-side(0), side(1)]
+    }
+
+    /// The amplitudes of p's kinks for q̃'s end coefficients `ends`.
+    fn pressure(&self, ends: [f64; 2]) -> [f64; 2] {
+        let a = self.pressure_coefficients(ends);
+        [a[0] * self.to_amplitude[0], a[1] * self.to_amplitude[1]]
+    }
+
+    /// The amplitudes of w's kinks for q̃'s end coefficients `ends`.
+    fn charge(&self, ends: [f64; 2]) -> [f64; 2] {
+        let a = self.pressure_coefficients(ends);
+        // The friction-limited traction η s p on the stick side carries p's stick-side root
+        // −α A (right) or +α A (left); η s α = (κ/Y*) η².
+        let eta_s_alpha = self.kappa * self.eta * self.eta;
+        let left = -self.charge * (ends[0] + eta_s_alpha * a[0]);
+        let right = self.charge * (ends[1] - eta_s_alpha * a[1]);
+        [left * self.to_amplitude[0], right * self.to_amplitude[1]]
+    }
+}
+
+/// `ψ(−1)` and `ψ(1)` of a bounded series, `Σ (±1)ⁿ (n + 1) β_n` (`U_n(±1) = (±1)ⁿ (n + 1)`):
+/// on a zone of half-width h the density starts like `√(2/h) ψ(∓1) √(distance to the end)`.
+fn end_values(beta: &[f64]) -> [f64; 2] {
+    let (mut left, mut right) = (0.0, 0.0);
+    for (n, b) in beta.iter().enumerate() {
+        let w = (n + 1) as f64 * b;
+        right += w;
+        left += if n % 2 == 0 { w } else { -w };
+    }
+    [left, right]
 }
 
 /// The linear maps of the inner iteration at one geometry, as matrices on the series
@@ -437,6 +604,17 @@ struct InnerMaps {
     shape_weights: RowMatrix,
     /// S at the stick points.
     stick_shape: Vec<f64>,
+    /// `η s` of [`Coefficients::shape`].
+    shape: Option<f64>,
+    /// The slip zones `[c − a, lo]` and `[hi, c + a]` that carry the kinks, and a.
+    kink_zones: [(f64, f64); 2],
+    half_width: f64,
+    /// The kink functions (half-ellipses over a, [`super::half_ellipse`]) at the sample points
+    /// and at the shape nodes, and their Cauchy transforms at the stick points; empty when the
+    /// pressure has no kinks.
+    kinks_at_samples: Vec<[f64; 2]>,
+    kinks_at_nodes: Vec<[f64; 2]>,
+    kink_cauchy_at_stick: Vec<[f64; 2]>,
 }
 
 impl InnerMaps {
@@ -503,6 +681,24 @@ impl InnerMaps {
         } else {
             (RowMatrix::default(), RowMatrix::default())
         };
+        let kink_zones = [(c - a, stick.lo), (stick.hi, c + a)];
+        let kink = |x: f64| kink_zones.map(|(u, v)| half_ellipse(x, u, v) / a);
+        let (mut kinks_at_samples, mut kinks_at_nodes, mut kink_cauchy_at_stick) =
+            (Vec::new(), Vec::new(), Vec::new());
+        if k.kinks {
+            kinks_at_samples = sample_points.iter().map(|&x| kink(x)).collect();
+            kink_cauchy_at_stick = stick_points
+                .iter()
+                .map(|&x| kink_zones.map(|(u, v)| half_ellipse_cauchy(x, u, v) / a))
+                .collect();
+            if k.shape.is_none() {
+                kinks_at_nodes = state
+                    .shape_quadrature(stick)
+                    .iter()
+                    .map(|&(t, _, _)| kink(t))
+                    .collect();
+            }
+        }
         Self {
             stick_from_p,
             stick_from_w,
@@ -511,7 +707,19 @@ impl InnerMaps {
             shape_nodes,
             shape_weights,
             stick_shape,
+            shape: k.shape,
+            kink_zones,
+            half_width: a,
+            kinks_at_samples,
+            kinks_at_nodes,
+            kink_cauchy_at_stick,
         }
+    }
+
+    /// `H'` of the two kink functions at x.
+    fn kink_cauchy(&self, x: f64) -> [f64; 2] {
+        self.kink_zones
+            .map(|(u, v)| half_ellipse_cauchy(x, u, v) / self.half_width)
     }
 }
 
@@ -869,6 +1077,7 @@ struct Attempts {
 
 impl Attempts {
     fn record(&mut self, failed: Failed) {
+        if std::env::var("KINKDBG3").is_ok() { eprintln!("attempt failed: {}", failed.failure); }
         self.first_failure.get_or_insert(failed.failure);
         if let Some(step) = failed.stalled
             && self
