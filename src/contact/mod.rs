@@ -230,10 +230,6 @@ pub struct StickZone {
     /// square-root structure of the memory at old stick ends (see [`Inherited`]).
     #[serde(skip)]
     pub inherited: Option<std::sync::Arc<Inherited>>,
-    /// The square-root coefficients `[k_lo, k_hi]` of the whole q̃ (own and inherited) at the
-    /// ends, `q̃ ≈ k_lo √(x − lo)` and `q̃ ≈ k_hi √(hi − x)` (Pa/√m), which fix the kinks of
-    /// p and w ([`Kinks`]); zero for a zone solved without them.
-    pub end_roots: [f64; 2],
     /// `H'q̃` tabulated once the zone begins a phase ([`StickZone::tabulate_cauchy`]).
     #[serde(skip)]
     cauchy_table: TableCache,
@@ -317,7 +313,7 @@ impl PartialEq for Inherited {
     }
 }
 
-fn smootherstep(v: f64) -> f64 {
+pub(crate) fn smootherstep(v: f64) -> f64 {
     let v = v.clamp(0.0, 1.0);
     v * v * v * (v * (6.0 * v - 15.0) + 10.0)
 }
@@ -397,27 +393,6 @@ impl Inherited {
         } else {
             self.zone.correction_at(x)
         }
-    }
-
-    /// The square-root coefficients this link adds to q̃ at the ends `lo` and `hi` of the zone
-    /// that inherits it: the earlier zone's [`StickZone::end_roots`] where it ends at the same
-    /// point (a return to a remembered zone) without a fade, zero elsewhere (a link's q̃ is
-    /// zero beyond its zone, and a fade ramp vanishes like a fifth power).
-    pub fn end_roots(&self, lo: f64, hi: f64) -> [f64; 2] {
-        let slack = 1e-12 * (hi - lo);
-        let z = &self.zone;
-        [
-            if self.ramp_lo.is_none() && (z.lo - lo).abs() <= slack {
-                z.end_roots[0]
-            } else {
-                0.0
-            },
-            if self.ramp_hi.is_none() && (z.hi - hi).abs() <= slack {
-                z.end_roots[1]
-            } else {
-                0.0
-            },
-        ]
     }
 
     /// Breakpoints of the quadrature over the earlier zone.
@@ -509,7 +484,6 @@ impl StickZone {
             correction,
             kink,
             inherited: None,
-            end_roots: [0.0; 2],
             cauchy_table: TableCache::default(),
         }
     }
@@ -1321,7 +1295,8 @@ impl ContactState {
     pub fn surface_displacement(&self, model: &ContactModel, x: f64) -> f64 {
         let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
         let local = model.local_pressure_strain(self.split);
-        let local_density = |s: f64| local * self.pressure_at(s) + w13 * self.potential_charge_at(s);
+        let local_density =
+            |s: f64| local * self.pressure_at(s) + w13 * self.potential_charge_at(s);
         let traction = |s: f64| self.traction_at(s);
         -0.5 * self.sign_integral(x, &local_density)
             - model.compliance.y11 / std::f64::consts::PI
