@@ -230,6 +230,11 @@ pub struct StickZone {
     /// square-root structure of the memory at old stick ends (see [`Inherited`]).
     #[serde(skip)]
     pub inherited: Option<std::sync::Arc<Inherited>>,
+    /// The square-root coefficients `[k_lo, k_hi]` of the whole q̃ at the ends,
+    /// `q̃ ≈ k_lo √(x − lo)` and `q̃ ≈ k_hi √(hi − x)` (Pa/√m): they fix the kinks of p and w
+    /// here and, once the zone is remembered, at its ends inside later stick zones. Zero for a
+    /// zone solved without kinks (normal loading, uncoupled contacts).
+    pub end_roots: [f64; 2],
     /// `H'q̃` tabulated once the zone begins a phase ([`StickZone::tabulate_cauchy`]).
     #[serde(skip)]
     cauchy_table: TableCache,
@@ -395,6 +400,34 @@ impl Inherited {
         }
     }
 
+    /// The remembered stick ends strictly inside `(lo, hi)` where this link's q̃ (with its
+    /// chain) starts like a square root, as `(point, side, k)`: side −1 at a zone's left end
+    /// (q̃ ≈ k √(x − point)), +1 at its right end, k the zone's [`StickZone::end_roots`]
+    /// times the fades in between. A point already listed by an outer zone (a return to a
+    /// remembered end) is not repeated.
+    pub fn interior_roots(&self, lo: f64, hi: f64) -> Vec<(f64, f64, f64)> {
+        let mut out: Vec<(f64, f64, f64)> = Vec::new();
+        let slack = 1e-9 * (hi - lo);
+        let mut factors: Vec<&Inherited> = Vec::new();
+        let mut link = Some(self);
+        while let Some(l) = link {
+            factors.push(l);
+            let z = &l.zone;
+            for (x0, side, k) in [(z.lo, -1.0, z.end_roots[0]), (z.hi, 1.0, z.end_roots[1])] {
+                let fade: f64 = factors.iter().map(|f| f.chi(x0)).product();
+                if x0 > lo + slack
+                    && x0 < hi - slack
+                    && (k * fade).abs() > 0.0
+                    && out.iter().all(|o| (o.0 - x0).abs() > slack)
+                {
+                    out.push((x0, side, k * fade));
+                }
+            }
+            link = z.inherited.as_deref();
+        }
+        out
+    }
+
     /// Breakpoints of the quadrature over the earlier zone.
     fn pieces(&self) -> Vec<f64> {
         let mut pts = vec![self.zone.lo];
@@ -484,6 +517,7 @@ impl StickZone {
             correction,
             kink,
             inherited: None,
+            end_roots: [0.0; 2],
             cauchy_table: TableCache::default(),
         }
     }
@@ -677,19 +711,34 @@ impl StickZone {
     }
 }
 
-/// Amplitudes of the square-root kinks of a density (the pressure p or the charge w) at the
-/// stick ends: the density is `series + (left·e(x; c − a, lo) + right·e(x; hi, c + a))/a`
-/// with the half-ellipse `e(x; u, v) = √((x − u)(v − x))` on `[u, v]` (zero elsewhere), which
-/// starts like a square root at the stick end on the slip side, vanishes like one at the
-/// contact end, and has a Cauchy transform in closed form ([`half_ellipse_cauchy`]). Zero
-/// unless the density is coupled to the stick traction; see the tangential module docs
-/// ("Kinks at the stick ends") for where the kinks come from and how the amplitudes are fixed.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
-pub struct Kinks {
-    /// Amplitude on the left slip zone (the density's unit).
-    pub left: f64,
-    /// Amplitude on the right slip zone.
-    pub right: f64,
+/// One square-root kink of a density (the pressure p or the charge w): the term
+/// `amplitude · e(x)/a` with the half-ellipse `e(x; u, v) = √((x − u)(v − x))` ([`half_ellipse`])
+/// on the slip-side stretch from the kink point `at` to the contact end on `side` (`[at, c + a]`
+/// for side +1, `[c − a, at]` for side −1). It starts like a square root at `at`, vanishes like
+/// one at the contact end and has a Cauchy transform in closed form ([`half_ellipse_cauchy`]).
+/// See the tangential module docs ("Kinks at the stick ends") for where the kinks come from
+/// and how the amplitudes are fixed.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Kink {
+    /// Kink point (m).
+    pub at: f64,
+    /// +1: the term lies right of the kink point; −1: left.
+    pub side: f64,
+    /// Amplitude (the density's unit).
+    pub amplitude: f64,
+}
+
+/// The kinks of a density; empty unless it is coupled to a stick traction.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct Kinks(pub Vec<Kink>);
+
+/// The stretch `[u, v]` of a kink term at `at` on `side` of a contact `[c − a, c + a]`.
+pub fn kink_domain(at: f64, side: f64, centre: f64, half_width: f64) -> (f64, f64) {
+    if side > 0.0 {
+        (at, centre + half_width)
+    } else {
+        (centre - half_width, at)
+    }
 }
 
 /// `√((x − u)(v − x))` on `[u, v]`, zero outside (m).
@@ -773,26 +822,18 @@ impl ContactState {
         self.potential_charge.density(self.tau(x)) + self.kinks_at(&self.charge_kinks, x)
     }
 
-    /// The slip zones `[c − a, lo]` and `[hi, c + a]` when `kinks` has an amplitude.
-    fn kink_zones(&self, kinks: &Kinks) -> Option<[(f64, f64); 2]> {
-        if kinks.left.abs() <= 0.0 && kinks.right.abs() <= 0.0 {
-            return None;
-        }
-        let stick = self.traction.stick.as_ref()?;
-        let (c, a) = (self.centre, self.half_width);
-        Some([(c - a, stick.lo), (stick.hi, c + a)])
-    }
-
-    /// `(left e_L(x) + right e_R(x))/a` for the kink functions of [`Kinks`], or with `f` in
-    /// place of the half-ellipse (its transform or integral).
+    /// `Σ amplitude · f(u, v)/a` over the kink terms (stretches `[u, v]`, [`kink_domain`]):
+    /// with the half-ellipse, its transform or its integral as f.
     fn kinks_with(&self, kinks: &Kinks, f: impl Fn(f64, f64) -> f64) -> f64 {
-        match self.kink_zones(kinks) {
-            Some([left, right]) => {
-                (kinks.left * f(left.0, left.1) + kinks.right * f(right.0, right.1))
-                    / self.half_width
-            }
-            None => 0.0,
-        }
+        kinks
+            .0
+            .iter()
+            .map(|k| {
+                let (u, v) = kink_domain(k.at, k.side, self.centre, self.half_width);
+                k.amplitude * f(u, v)
+            })
+            .sum::<f64>()
+            / self.half_width
     }
 
     fn kinks_at(&self, kinks: &Kinks, x: f64) -> f64 {

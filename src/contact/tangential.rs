@@ -91,7 +91,8 @@ use super::memory::Memory;
 use super::normal::arcsine_moment;
 use super::pressure::{Discretisation, electric_resultants};
 use super::{
-    ContactModel, ContactState, Inherited, Kinks, StickZone, half_ellipse, half_ellipse_cauchy,
+    ContactModel, ContactState, Inherited, Kink, Kinks, StickZone, half_ellipse, half_ellipse_cauchy,
+    kink_domain,
     smootherstep,
 };
 
@@ -304,24 +305,34 @@ impl StepProblem<'_> {
                 local_over_y11: local / y11,
                 shape: (!mixed).then_some(eta * self.signs.0),
                 charge: split.conducting.then_some(w13 / y11),
-                kinks: coupled,
             },
         );
-        // The kinks of p and w: H' of the two half-ellipses at the pressure and charge points,
-        // and the amplitudes' relation to the end coefficients of q̃ (see `KinkRelation`).
-        let kink_cauchy_at = |points: &[f64]| -> Vec<[f64; 2]> {
-            if coupled {
-                points.iter().map(|&x| maps.kink_cauchy(x)).collect()
-            } else {
-                Vec::new()
-            }
-        };
-        let kink_cauchy_at_pressure = kink_cauchy_at(&pressure_points);
-        let kink_cauchy_at_charge = kink_cauchy_at(&charge_points[..nc.min(charge_points.len())]);
-        let relation = KinkRelation::new(g, m, kappa / ystar, w13_over_y33, eta, self.signs);
-        // q̃'s square-root coefficients at the ends are estimated from its values at
-        // `END_PROBE` and twice that of the half-width inside each end (see `end_roots`).
+        // The kinks of p and w: at the new stick ends, whose q̃ roots are unknowns of the inner
+        // iteration, estimated from q̃ at `END_PROBE` and twice that of the half-width inside
+        // each end (see `EndProbes`), and at the remembered stick ends inside the zone, whose
+        // roots the chain carries.
         let probes = EndProbes::new(g, m, inherited.as_deref());
+        let kinks = if coupled {
+            let mut points = vec![(g.lo, -1.0, 0.0), (g.hi, 1.0, 0.0)];
+            if let Some(z) = &inherited {
+                points.extend(z.interior_roots(g.lo, g.hi));
+            }
+            KinkMaps::new(
+                &state,
+                &points,
+                KinkPoints {
+                    pressure: &pressure_points,
+                    charge: &charge_points[..nc],
+                    stick: &stick_points,
+                    samples: &sample_points,
+                    mixed,
+                },
+                m,
+                [kappa / ystar, w13_over_y33, eta],
+            )
+        } else {
+            KinkMaps::default()
+        };
         // The inner unknown: q at the pressure points, then at the charge points, then (when
         // coupled) q̃'s end coefficients.
         let mut x: Vec<f64> = sample_points
@@ -353,19 +364,15 @@ impl StepProblem<'_> {
             } else {
                 [0.0; 2]
             };
-            let amp = relation.pressure(ends);
+            let roots = kinks.roots(ends);
+            let amp = kinks.pressure_amplitudes(&roots);
             for ((r, &xp), q) in rhs.iter_mut().zip(&pressure_points).zip(&x[..np]) {
                 *r = -xp * scale - kappa / ystar * q;
             }
-            for (r, h) in rhs.iter_mut().zip(&kink_cauchy_at_pressure) {
-                *r -= amp[0] * h[0] + amp[1] * h[1];
-            }
+            add_product(&kinks.cauchy_at_pressure, &amp, -1.0, &mut rhs);
             lambda_p = disc.bounded.solve_coefficients(&rhs, &mut beta_p);
             state.pressure.beta.clone_from(&beta_p);
-            state.pressure_kinks = Kinks {
-                left: amp[0],
-                right: amp[1],
-            };
+            state.pressure_kinks = kinks.kinks(&amp);
             // Charge (seed eqs. 53, 55, 41–42) for the current shear traction. The arcsine
             // moment of q fixes Γ under potential control; under charge control it only gives
             // φ0 and is evaluated once for the accepted state.
@@ -383,17 +390,12 @@ impl StepProblem<'_> {
                 state.charge = charge;
                 state.potential = potential;
                 let free = charge - model.pressure_charge(self.normal_load);
-                let w_amp = relation.charge(ends);
-                state.charge_kinks = Kinks {
-                    left: w_amp[0],
-                    right: w_amp[1],
-                };
+                let w_amp = kinks.charge_amplitudes(&roots, &amp);
+                state.charge_kinks = kinks.kinks(&w_amp);
                 for (r, q) in crhs.iter_mut().zip(&x[np..np + nc]) {
                     *r = -e.w13 / e.y33 * q;
                 }
-                for (r, h) in crhs.iter_mut().zip(&kink_cauchy_at_charge) {
-                    *r -= w_amp[0] * h[0] + w_amp[1] * h[1];
-                }
+                add_product(&kinks.cauchy_at_charge, &w_amp, -1.0, &mut crhs);
                 let kinks_force =
                     state.potential_charge_force() - g.a * state.potential_charge.integral();
                 disc.unbounded
@@ -403,10 +405,8 @@ impl StepProblem<'_> {
             // Stick traction (seed eqs. 50–51/58–59, 60, 63); `H'(pS)` is `s H'p` when both slip
             // zones have the same sign s.
             maps.stick_from_p.apply(&beta_p, &mut srhs);
-            if let (true, Some(eta_s)) = (coupled, maps.shape) {
-                for (r, h) in srhs.iter_mut().zip(&maps.kink_cauchy_at_stick) {
-                    *r -= eta_s * (amp[0] * h[0] + amp[1] * h[1]);
-                }
+            if let Some(eta_s) = maps.shape {
+                add_product(&kinks.cauchy_at_stick, &amp, -eta_s, &mut srhs);
             }
             if split.conducting {
                 maps.stick_from_w.apply(&gamma, &mut work);
@@ -417,14 +417,8 @@ impl StepProblem<'_> {
             if mixed {
                 maps.cauchy_at_stick.apply(&beta_p, &mut work);
                 maps.shape_nodes.apply(&beta_p, &mut p_nodes);
-                if coupled {
-                    for (w, h) in work.iter_mut().zip(&maps.kink_cauchy_at_stick) {
-                        *w += amp[0] * h[0] + amp[1] * h[1];
-                    }
-                    for (p, e) in p_nodes.iter_mut().zip(&maps.kinks_at_nodes) {
-                        *p += amp[0] * e[0] + amp[1] * e[1];
-                    }
-                }
+                add_product(&kinks.cauchy_at_stick, &amp, 1.0, &mut work);
+                add_product(&kinks.at_nodes, &amp, 1.0, &mut p_nodes);
                 for (i, r) in srhs.iter_mut().enumerate() {
                     let shape =
                         maps.stick_shape[i] * work[i] + dot(maps.shape_weights.row(i), &p_nodes);
@@ -437,8 +431,8 @@ impl StepProblem<'_> {
             lambda_q = disc.bounded.solve_coefficients(&srhs, &mut beta_q);
             for (k, (shape, inh)) in fixed_p.iter().chain(&fixed_c).enumerate() {
                 let mut p = dot(disc.bounded_at_collocation.row(k), &beta_p);
-                if let Some(e) = maps.kinks_at_samples.get(k) {
-                    p += amp[0] * e[0] + amp[1] * e[1];
+                if kinks.at_samples.rows() > 0 {
+                    p += dot(kinks.at_samples.row(k), &amp);
                 }
                 fx[k] = eta * p * shape + dot(maps.own_at_samples.row(k), &beta_q) + inh;
             }
@@ -449,6 +443,7 @@ impl StepProblem<'_> {
             }
             if let Some(stick) = state.traction.stick.as_mut() {
                 stick.correction.beta.clone_from(&beta_q);
+                stick.end_roots = ends;
             }
             let p0 = state.pressure_at(g.c).abs().max(1e-300);
             let largest_change = |from: usize, to: usize| {
@@ -505,74 +500,190 @@ struct Coefficients {
     shape: Option<f64>,
     /// `w13/y11` when the charge is an unknown (conducting punch).
     charge: Option<f64>,
-    /// Whether the pressure carries kinks (κ ≠ 0).
-    kinks: bool,
 }
 
-/// The local relations that fix the amplitudes of the kinks of p and w from q̃'s behaviour at
-/// the stick ends (tangential module docs, "Kinks at the stick ends").
-struct KinkRelation {
-    /// κ/Y*.
-    kappa: f64,
-    /// w13/y33 (zero without a charge unknown).
+/// `y += factor · A x` (nothing when A has no rows).
+fn add_product(a: &RowMatrix, x: &[f64], factor: f64, y: &mut [f64]) {
+    if a.rows() == 0 {
+        return;
+    }
+    for (i, yi) in y.iter_mut().enumerate() {
+        *yi += factor * dot(a.row(i), x);
+    }
+}
+
+/// Where the kink functions are needed in an evaluation.
+struct KinkPoints<'a> {
+    pressure: &'a [f64],
+    charge: &'a [f64],
+    stick: &'a [f64],
+    samples: &'a [f64],
+    /// Whether the slip signs differ (the shape quadrature needs p at its nodes).
+    mixed: bool,
+}
+
+/// The kink terms of one evaluation (tangential module docs, "Kinks at the stick ends"): their
+/// points, the local relations that give their amplitudes from q̃'s root coefficients, and the
+/// kink functions (half-ellipses over a) and their Cauchy transforms at the points where the
+/// inner iteration needs them, as matrices over the terms.
+#[derive(Default)]
+struct KinkMaps {
+    /// `(point, side)` of each term; the first two are the new stick ends.
+    points: Vec<(f64, f64)>,
+    /// The roots k of the remembered terms (from the third on).
+    fixed_roots: Vec<f64>,
+    /// Per term: `side (κ/Y*)/(1 + α²)`, `α = κηS/Y*` with S the slip shape at the point.
+    pressure_factor: Vec<f64>,
+    /// Per term: `(κ/Y*) η² S²`, the factor of p's stick-side root in w's relation.
+    stick_side: Vec<f64>,
+    /// Per term: the factor from a root coefficient to the amplitude of the half-ellipse
+    /// over a, `a/√L` (L the term's stretch), switched off for stretches the grid does not
+    /// resolve.
+    to_amplitude: Vec<f64>,
+    /// w13/y33.
     charge: f64,
-    eta: f64,
-    /// `α = κηs/Y*` of the left and right slip zones.
-    alpha: [f64; 2],
-    /// `a/√L` of the left and right slip zones (length L; zero when L vanishes): the factor
-    /// from a square-root coefficient to the amplitude of a half-ellipse over a.
-    to_amplitude: [f64; 2],
+    cauchy_at_pressure: RowMatrix,
+    cauchy_at_charge: RowMatrix,
+    cauchy_at_stick: RowMatrix,
+    at_samples: RowMatrix,
+    at_nodes: RowMatrix,
 }
 
-impl KinkRelation {
-    /// The relation for a geometry with M collocation points. A slip zone narrower than the
-    /// grid spacing at the contact ends, `a (π/M)²`, holds no collocation point; its kink is
-    /// switched off smoothly (smootherstep between one and two spacings): unresolved, it
-    /// only disturbed the search for the first state after a reversal, whose edge slip zones
-    /// start that thin (insulating Figure-3 history: a left slip zone of 8e−5 a).
-    fn new(g: &Geometry, m: usize, kappa: f64, charge: f64, eta: f64, signs: (f64, f64)) -> Self {
-        let spacing = g.a * (std::f64::consts::PI / m as f64).powi(2);
-        let to_amplitude = |length: f64| {
-            let resolved = smootherstep(length / spacing - 1.0);
-            if resolved > 0.0 {
-                resolved * g.a / length.sqrt()
-            } else {
-                0.0
+impl KinkMaps {
+    /// The maps for the terms `points` (`(point, side, root)`, the root used only for the
+    /// remembered ones) on `state`'s geometry; `coefficients` are κ/Y*, w13/y33 and η.
+    ///
+    /// A stretch narrower than the grid spacing at the contact ends, `a (π/M)²`, holds no
+    /// collocation point; its term is switched off smoothly (smootherstep between one and two
+    /// spacings): unresolved, it only disturbed the search for the first state after a
+    /// reversal, whose edge slip zones start that thin (insulating Figure-3 history: a left
+    /// slip zone of 8e−5 a).
+    fn new(
+        state: &ContactState,
+        points: &[(f64, f64, f64)],
+        at: KinkPoints<'_>,
+        m: usize,
+        coefficients: [f64; 3],
+    ) -> Self {
+        let [kappa, charge, eta] = coefficients;
+        let (c, a) = (state.centre, state.half_width);
+        let spacing = a * (std::f64::consts::PI / m as f64).powi(2);
+        let domains: Vec<(f64, f64)> = points
+            .iter()
+            .map(|&(x0, side, _)| kink_domain(x0, side, c, a))
+            .collect();
+        let shape: Vec<f64> = points
+            .iter()
+            .enumerate()
+            .map(|(j, &(x0, _, _))| match j {
+                0 => state.traction.left_sign,
+                1 => state.traction.right_sign,
+                _ => state.slip_shape(x0),
+            })
+            .collect();
+        let pressure_factor = points
+            .iter()
+            .zip(&shape)
+            .map(|(&(_, side, _), s)| {
+                let alpha = kappa * eta * s;
+                side * kappa / (1.0 + alpha * alpha)
+            })
+            .collect();
+        let stick_side = shape.iter().map(|s| kappa * eta * eta * s * s).collect();
+        let to_amplitude = domains
+            .iter()
+            .map(|&(u, v)| {
+                let length = v - u;
+                let resolved = smootherstep(length / spacing - 1.0);
+                if resolved > 0.0 {
+                    resolved * a / length.sqrt()
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let table = |xs: &[f64], f: &dyn Fn(f64, f64, f64) -> f64| {
+            let mut out = RowMatrix::zeros(xs.len(), points.len());
+            for (i, &x) in xs.iter().enumerate() {
+                for (o, &(u, v)) in out.row_mut(i).iter_mut().zip(&domains) {
+                    *o = f(x, u, v) / a;
+                }
             }
+            out
+        };
+        let nodes: Vec<f64> = match (&state.traction.stick, at.mixed) {
+            (Some(stick), true) => state
+                .shape_quadrature(stick)
+                .iter()
+                .map(|&(t, _, _)| t)
+                .collect(),
+            _ => Vec::new(),
         };
         Self {
-            kappa,
+            points: points.iter().map(|&(x0, side, _)| (x0, side)).collect(),
+            fixed_roots: points.iter().skip(2).map(|&(_, _, k)| k).collect(),
+            pressure_factor,
+            stick_side,
+            to_amplitude,
             charge,
-            eta,
-            alpha: [kappa * eta * signs.0, kappa * eta * signs.1],
-            to_amplitude: [
-                to_amplitude(g.lo - (g.c - g.a)),
-                to_amplitude(g.c + g.a - g.hi),
-            ],
+            cauchy_at_pressure: table(at.pressure, &half_ellipse_cauchy),
+            cauchy_at_charge: table(at.charge, &half_ellipse_cauchy),
+            cauchy_at_stick: table(at.stick, &half_ellipse_cauchy),
+            at_samples: table(at.samples, &half_ellipse),
+            at_nodes: table(&nodes, &half_ellipse),
         }
     }
 
-    /// The square-root coefficients `[A_L, A_R]` of p on the slip side of each stick end.
-    fn pressure_coefficients(&self, ends: [f64; 2]) -> [f64; 2] {
-        let side = |j: usize| self.kappa * ends[j] / (1.0 + self.alpha[j] * self.alpha[j]);
-        [-side(0), side(1)]
+    /// The root coefficients of all terms for the new stick ends' `ends`.
+    fn roots(&self, ends: [f64; 2]) -> Vec<f64> {
+        if self.points.is_empty() {
+            return Vec::new();
+        }
+        ends.iter().chain(&self.fixed_roots).copied().collect()
     }
 
-    /// The amplitudes of p's kinks for q̃'s end coefficients `ends`.
-    fn pressure(&self, ends: [f64; 2]) -> [f64; 2] {
-        let a = self.pressure_coefficients(ends);
-        [a[0] * self.to_amplitude[0], a[1] * self.to_amplitude[1]]
+    /// The amplitudes of p's kinks: p's root on the slip side of each point is
+    /// `A = side (κ/Y*) k/(1 + α²)`.
+    fn pressure_amplitudes(&self, roots: &[f64]) -> Vec<f64> {
+        roots
+            .iter()
+            .zip(&self.pressure_factor)
+            .zip(&self.to_amplitude)
+            .map(|((k, f), t)| f * k * t)
+            .collect()
     }
 
-    /// The amplitudes of w's kinks for q̃'s end coefficients `ends`.
-    fn charge(&self, ends: [f64; 2]) -> [f64; 2] {
-        let a = self.pressure_coefficients(ends);
-        // The friction-limited traction η s p on the stick side carries p's stick-side root
-        // −α A (right) or +α A (left); η s α = (κ/Y*) η².
-        let eta_s_alpha = self.kappa * self.eta * self.eta;
-        let left = -self.charge * (ends[0] + eta_s_alpha * a[0]);
-        let right = self.charge * (ends[1] - eta_s_alpha * a[1]);
-        [left * self.to_amplitude[0], right * self.to_amplitude[1]]
+    /// The amplitudes of w's kinks, `B = side (w13/y33)(k − side (κ/Y*) η² S² A)` for p's
+    /// amplitudes `p_amp` (q = ηSp + q̃ carries p's stick-side root −side α A next to q̃'s).
+    fn charge_amplitudes(&self, roots: &[f64], p_amp: &[f64]) -> Vec<f64> {
+        roots
+            .iter()
+            .zip(p_amp)
+            .enumerate()
+            .map(|(j, (k, amp))| {
+                let side = self.points[j].1;
+                let t = self.to_amplitude[j];
+                // p's root from its amplitude (t = 0 switches the term off either way).
+                let root_p = if t > 0.0 { amp / t } else { 0.0 };
+                side * self.charge * (k - side * self.stick_side[j] * root_p) * t
+            })
+            .collect()
+    }
+
+    /// The kink terms with amplitudes `amp`.
+    fn kinks(&self, amp: &[f64]) -> Kinks {
+        Kinks(
+            self.points
+                .iter()
+                .zip(amp)
+                .filter(|(_, a)| a.abs() > 0.0)
+                .map(|(&(at, side), &amplitude)| Kink {
+                    at,
+                    side,
+                    amplitude,
+                })
+                .collect(),
+        )
     }
 }
 
@@ -661,15 +772,6 @@ struct InnerMaps {
     stick_shape: Vec<f64>,
     /// `η s` of [`Coefficients::shape`].
     shape: Option<f64>,
-    /// The slip zones `[c − a, lo]` and `[hi, c + a]` that carry the kinks, and a.
-    kink_zones: [(f64, f64); 2],
-    half_width: f64,
-    /// The kink functions (half-ellipses over a, [`super::half_ellipse`]) at the sample points
-    /// and at the shape nodes, and their Cauchy transforms at the stick points; empty when the
-    /// pressure has no kinks.
-    kinks_at_samples: Vec<[f64; 2]>,
-    kinks_at_nodes: Vec<[f64; 2]>,
-    kink_cauchy_at_stick: Vec<[f64; 2]>,
 }
 
 impl InnerMaps {
@@ -736,24 +838,6 @@ impl InnerMaps {
         } else {
             (RowMatrix::default(), RowMatrix::default())
         };
-        let kink_zones = [(c - a, stick.lo), (stick.hi, c + a)];
-        let kink = |x: f64| kink_zones.map(|(u, v)| half_ellipse(x, u, v) / a);
-        let (mut kinks_at_samples, mut kinks_at_nodes, mut kink_cauchy_at_stick) =
-            (Vec::new(), Vec::new(), Vec::new());
-        if k.kinks {
-            kinks_at_samples = sample_points.iter().map(|&x| kink(x)).collect();
-            kink_cauchy_at_stick = stick_points
-                .iter()
-                .map(|&x| kink_zones.map(|(u, v)| half_ellipse_cauchy(x, u, v) / a))
-                .collect();
-            if k.shape.is_none() {
-                kinks_at_nodes = state
-                    .shape_quadrature(stick)
-                    .iter()
-                    .map(|&(t, _, _)| kink(t))
-                    .collect();
-            }
-        }
         Self {
             stick_from_p,
             stick_from_w,
@@ -763,19 +847,9 @@ impl InnerMaps {
             shape_weights,
             stick_shape,
             shape: k.shape,
-            kink_zones,
-            half_width: a,
-            kinks_at_samples,
-            kinks_at_nodes,
-            kink_cauchy_at_stick,
         }
     }
 
-    /// `H'` of the two kink functions at x.
-    fn kink_cauchy(&self, x: f64) -> [f64; 2] {
-        self.kink_zones
-            .map(|(u, v)| half_ellipse_cauchy(x, u, v) / self.half_width)
-    }
 }
 
 /// Anderson acceleration (type II) of a fixed-point iteration `x ← F(x)`: the next iterate
