@@ -235,6 +235,12 @@ pub struct StickZone {
     /// here and, once the zone is remembered, at its ends inside later stick zones. Zero for a
     /// zone solved without kinks (normal loading, uncoupled contacts).
     pub end_roots: [f64; 2],
+    /// The slip signs beside the ends when the zone was solved (left, right).
+    pub end_signs: [f64; 2],
+    /// Closed-form parts of q̃ that carry the kinks of remembered stick ends inside the zone:
+    /// `amplitude · √((x − u)(v − x))` on `[u, v]`, as `(u, v, amplitude)` (tangential module
+    /// docs, "Kinks at the stick ends").
+    pub extras: Vec<(f64, f64, f64)>,
     /// `H'q̃` tabulated once the zone begins a phase ([`StickZone::tabulate_cauchy`]).
     #[serde(skip)]
     cauchy_table: TableCache,
@@ -401,26 +407,35 @@ impl Inherited {
     }
 
     /// The remembered stick ends strictly inside `(lo, hi)` where this link's q̃ (with its
-    /// chain) starts like a square root, as `(point, side, k)`: side −1 at a zone's left end
-    /// (q̃ ≈ k √(x − point)), +1 at its right end, k the zone's [`StickZone::end_roots`]
-    /// times the fades in between. A point already listed by an outer zone (a return to a
-    /// remembered end) is not repeated.
-    pub fn interior_roots(&self, lo: f64, hi: f64) -> Vec<(f64, f64, f64)> {
-        let mut out: Vec<(f64, f64, f64)> = Vec::new();
+    /// chain) starts like a square root ([`RememberedRoot`]). A point already listed by an
+    /// outer zone (a return to a remembered end) is not repeated.
+    pub fn interior_roots(&self, lo: f64, hi: f64) -> Vec<RememberedRoot> {
+        let mut out: Vec<RememberedRoot> = Vec::new();
         let slack = 1e-9 * (hi - lo);
+        let outer = &self.zone;
         let mut factors: Vec<&Inherited> = Vec::new();
         let mut link = Some(self);
         while let Some(l) = link {
             factors.push(l);
             let z = &l.zone;
-            for (x0, side, k) in [(z.lo, -1.0, z.end_roots[0]), (z.hi, 1.0, z.end_roots[1])] {
-                let fade: f64 = factors.iter().map(|f| f.chi(x0)).product();
+            for (j, (x0, side)) in [(z.lo, -1.0), (z.hi, 1.0)].into_iter().enumerate() {
+                let root = z.end_roots[j] * factors.iter().map(|f| f.chi(x0)).product::<f64>();
                 if x0 > lo + slack
                     && x0 < hi - slack
-                    && (k * fade).abs() > 0.0
-                    && out.iter().all(|o| (o.0 - x0).abs() > slack)
+                    && root.abs() > 0.0
+                    && out.iter().all(|o| (o.at - x0).abs() > slack)
                 {
-                    out.push((x0, side, k * fade));
+                    out.push(RememberedRoot {
+                        at: x0,
+                        side,
+                        root,
+                        sign: z.end_signs[j],
+                        carried_sign: if factors.len() == 1 {
+                            z.end_signs[j]
+                        } else {
+                            outer.end_sign_shape(x0)
+                        },
+                    });
                 }
             }
             link = z.inherited.as_deref();
@@ -485,6 +500,23 @@ impl Inherited {
     }
 }
 
+/// A remembered stick end inside a new stick zone, where q̃ starts like a square root (the
+/// tangential module docs, "Kinks at the stick ends").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RememberedRoot {
+    /// The point (m).
+    pub at: f64,
+    /// −1 at a remembered zone's left end (`q̃ ≈ root √(x − at)`), +1 at its right end.
+    pub side: f64,
+    /// The root coefficient (Pa/√m), times the fades of the links in between.
+    pub root: f64,
+    /// The slip sign beside the end when the root formed.
+    pub sign: f64,
+    /// The slip sign S at the point of the outermost inherited zone, whose q̃ already carries
+    /// the root `(sign − S) η A` of p's kink beyond the point.
+    pub carried_sign: f64,
+}
+
 /// `k(u) = −(2u/π) artanh √(1 − u²)`: the bounded solution of
 /// `(1/π)⨍ k(t)/(t − u) dt = |u| − 2/π` on (−1, 1). Its U-series coefficients decay only like
 /// n⁻², so it is kept in closed form; `k(u)/√(1−u²) → −2/π` at u = ±1.
@@ -518,8 +550,18 @@ impl StickZone {
             kink,
             inherited: None,
             end_roots: [0.0; 2],
+            end_signs: [0.0; 2],
+            extras: Vec::new(),
             cauchy_table: TableCache::default(),
         }
+    }
+
+    /// The slip-shape S at x from the slip signs beside the ends when the zone was solved
+    /// (the smoothstep of [`ContactState::slip_shape`]).
+    pub fn end_sign_shape(&self, x: f64) -> f64 {
+        let v = ((x - self.lo) / (self.hi - self.lo)).clamp(0.0, 1.0);
+        let [l, r] = self.end_signs;
+        l + (r - l) * v * v * (3.0 - 2.0 * v)
     }
 
     /// Tabulate `H'q̃` (see `CauchyTable`) for a zone that will be evaluated many times (one
@@ -573,6 +615,12 @@ impl StickZone {
         }
         self.own_part(x, BoundedSeries::density, kink_density)
             + self.inherited.as_ref().map_or(0.0, |z| z.value(x))
+            + self.extras_with(|u, v| half_ellipse(x, u, v))
+    }
+
+    /// `Σ amplitude · f(u, v)` over the closed-form extras.
+    fn extras_with(&self, f: impl Fn(f64, f64) -> f64) -> f64 {
+        self.extras.iter().map(|&(u, v, amp)| amp * f(u, v)).sum()
     }
 
     /// `H'q̃(x)` (Pa), including the inherited chain (from the table when the zone has one).
@@ -588,6 +636,7 @@ impl StickZone {
     fn direct_cauchy(&self, x: f64) -> f64 {
         self.own_part(x, BoundedSeries::cauchy, kink_cauchy)
             + self.inherited.as_ref().map_or(0.0, |z| z.cauchy(x))
+            + self.extras_with(|u, v| half_ellipse_cauchy(x, u, v))
     }
 
     /// The zone's own series and kink term through `series` and `kink` (density or Cauchy
@@ -611,13 +660,14 @@ impl StickZone {
 
     /// Whether the zone carries nothing of its own: q̃ is exactly its inherited link's.
     fn carries_nothing(&self) -> bool {
-        self.correction.beta.is_empty() && self.kink.abs() <= 0.0
+        self.correction.beta.is_empty() && self.kink.abs() <= 0.0 && self.extras.is_empty()
     }
 
     /// `∫ q̃ dx` (N/m), including the inherited chain (the kink part is odd).
     pub fn correction_integral(&self) -> f64 {
         self.half() * self.correction.integral()
             + self.inherited.as_ref().map_or(0.0, |z| z.integral())
+            + self.extras_with(half_ellipse_integral)
     }
 
     /// What a new zone `[lo, hi]` inherits from this chain. The memory inside the new zone

@@ -239,6 +239,40 @@ impl StepProblem<'_> {
         let stick_points = mapped(&disc.bounded.collocation, mid, half);
         let pressure_points = mapped(&disc.bounded.collocation, g.c, g.a);
         let charge_points = mapped(&disc.unbounded.collocation, g.c, g.a);
+        let electric = split
+            .conducting
+            .then(|| model.compliance.electric)
+            .flatten();
+        let w13_over_y33 = electric.map_or(0.0, |e| e.w13 / e.y33);
+        let coupled = kappa.abs() > 0.0 || w13_over_y33.abs() > 0.0;
+        // The remembered stick ends inside the zone, `(point, side, root, sign)`, and the parts
+        // of q̃ that carry their kinks (module docs, "Kinks at the stick ends").
+        let interior = match (&inherited, coupled) {
+            (Some(z), true) if std::env::var("NOINT").is_err() => z.interior_roots(g.lo, g.hi),
+            _ => Vec::new(),
+        };
+        let new_zone = StickZone {
+            end_signs: [self.signs.0, self.signs.1],
+            ..StickZone::new(g.lo, g.hi, BoundedSeries::default(), 0.0)
+        };
+        let extras: Vec<(f64, f64, f64)> = interior
+            .iter()
+            .filter_map(|r| {
+                let (u, v) = kink_domain(r.at, r.side, g.c, g.a);
+                let root = pressure_root(r.side, kappa / ystar, eta, r.sign, r.root)
+                    * resolved(v - u, g.a, m);
+                let (u, v) = if r.side > 0.0 { (r.at, g.hi) } else { (g.lo, r.at) };
+                let change = r.carried_sign - new_zone.end_sign_shape(r.at);
+                let amplitude = change * eta * root / (v - u).sqrt();
+                (amplitude.abs() > 0.0 && std::env::var("NOEXTRA").is_err()).then_some((u, v, amplitude))
+            })
+            .collect();
+        // The part of q̃ fixed by the geometry: the inherited chain and the extras.
+        let closed = StickZone {
+            inherited: inherited.clone(),
+            extras,
+            ..new_zone
+        };
         // Parts of the stick right-hand side that do not change in the inner iteration (with
         // no charge unknown, whatever charge the state carries is among them).
         let fixed: Vec<f64> = stick_points
@@ -249,11 +283,10 @@ impl StepProblem<'_> {
                 } else {
                     w13 * guess.potential_charge_at(x) / y11
                 };
-                self.memory.strain(model, x) / y11 - inherited.as_ref().map_or(0.0, |z| z.cauchy(x))
-                    + fixed_charge
+                self.memory.strain(model, x) / y11 - closed.correction_cauchy(x) + fixed_charge
             })
             .collect();
-        let inherited_force = inherited.as_ref().map_or(0.0, |z| z.integral());
+        let inherited_force = closed.correction_integral();
         let mut state = guess.clone();
         state.shape_table = None;
         state.half_width = g.a;
@@ -262,10 +295,7 @@ impl StepProblem<'_> {
         state.traction.friction = eta;
         state.traction.left_sign = self.signs.0;
         state.traction.right_sign = self.signs.1;
-        state.traction.stick = Some(StickZone {
-            inherited: inherited.clone(),
-            ..StickZone::new(g.lo, g.hi, BoundedSeries::default(), 0.0)
-        });
+        state.traction.stick = Some(closed.clone());
         let mixed = (self.signs.0 - self.signs.1).abs() > 0.0;
         // The traction at the pressure and charge points is `η p S + q̃_own + q̃_inherited`;
         // S and the inherited part depend on the geometry only, so they are evaluated once.
@@ -273,7 +303,7 @@ impl StepProblem<'_> {
             points
                 .iter()
                 .map(|&x| {
-                    let inh = inherited.as_ref().map_or(0.0, |z| z.value(x));
+                    let inh = closed.correction_at(x);
                     (state.slip_shape(x), inh)
                 })
                 .collect()
@@ -290,12 +320,6 @@ impl StepProblem<'_> {
             .chain(&charge_points[..nc])
             .copied()
             .collect();
-        let electric = split
-            .conducting
-            .then(|| model.compliance.electric)
-            .flatten();
-        let w13_over_y33 = electric.map_or(0.0, |e| e.w13 / e.y33);
-        let coupled = kappa.abs() > 0.0 || w13_over_y33.abs() > 0.0;
         let maps = InnerMaps::new(
             &state,
             &stick_points,
@@ -311,12 +335,13 @@ impl StepProblem<'_> {
         // iteration, estimated from q̃ at `END_PROBE` and twice that of the half-width inside
         // each end (see `EndProbes`), and at the remembered stick ends inside the zone, whose
         // roots the chain carries.
-        let probes = EndProbes::new(g, m, inherited.as_deref());
+        let probes = EndProbes::new(g, m, &closed);
         let kinks = if coupled {
-            let mut points = vec![(g.lo, -1.0, 0.0), (g.hi, 1.0, 0.0)];
-            if let Some(z) = &inherited {
-                points.extend(z.interior_roots(g.lo, g.hi));
-            }
+            let mut points = vec![
+                (g.lo, -1.0, 0.0, self.signs.0),
+                (g.hi, 1.0, 0.0, self.signs.1),
+            ];
+            points.extend(interior.iter().map(|r| (r.at, r.side, r.root, r.sign)));
             KinkMaps::new(
                 &state,
                 &points,
@@ -366,6 +391,7 @@ impl StepProblem<'_> {
             };
             let roots = kinks.roots(ends);
             let amp = kinks.pressure_amplitudes(&roots);
+            let mut w_amp = vec![0.0; amp.len()];
             for ((r, &xp), q) in rhs.iter_mut().zip(&pressure_points).zip(&x[..np]) {
                 *r = -xp * scale - kappa / ystar * q;
             }
@@ -390,7 +416,7 @@ impl StepProblem<'_> {
                 state.charge = charge;
                 state.potential = potential;
                 let free = charge - model.pressure_charge(self.normal_load);
-                let w_amp = kinks.charge_amplitudes(&roots, &amp);
+                w_amp = kinks.charge_amplitudes(&roots, &amp);
                 state.charge_kinks = kinks.kinks(&w_amp);
                 for (r, q) in crhs.iter_mut().zip(&x[np..np + nc]) {
                     *r = -e.w13 / e.y33 * q;
@@ -408,6 +434,9 @@ impl StepProblem<'_> {
             if let Some(eta_s) = maps.shape {
                 add_product(&kinks.cauchy_at_stick, &amp, -eta_s, &mut srhs);
             }
+            // The remembered kinks' terms reach into the stick zone: their local parts.
+            add_product(&kinks.at_stick, &amp, local / y11, &mut srhs);
+            add_product(&kinks.at_stick, &w_amp, w13 / y11, &mut srhs);
             if split.conducting {
                 maps.stick_from_w.apply(&gamma, &mut work);
                 for (r, w) in srhs.iter_mut().zip(&work) {
@@ -512,6 +541,21 @@ fn add_product(a: &RowMatrix, x: &[f64], factor: f64, y: &mut [f64]) {
     }
 }
 
+/// p's square-root coefficient on the slip side of a kink point, `side (κ/Y*) k/(1 + α²)`,
+/// `α = κηS/Y*`, for q̃'s root k there and the slip sign S (module docs).
+fn pressure_root(side: f64, kappa: f64, eta: f64, sign: f64, k: f64) -> f64 {
+    let alpha = kappa * eta * sign;
+    side * kappa * k / (1.0 + alpha * alpha)
+}
+
+/// How far a kink term on a stretch of `length` is kept (1) or switched off (0): a stretch
+/// narrower than the grid spacing at the contact ends, `a (π/M)²`, holds no collocation point;
+/// smootherstep between one and two spacings.
+fn resolved(length: f64, a: f64, m: usize) -> f64 {
+    let spacing = a * (std::f64::consts::PI / m as f64).powi(2);
+    smootherstep(length / spacing - 1.0)
+}
+
 /// Where the kink functions are needed in an evaluation.
 struct KinkPoints<'a> {
     pressure: &'a [f64],
@@ -532,7 +576,8 @@ struct KinkMaps {
     points: Vec<(f64, f64)>,
     /// The roots k of the remembered terms (from the third on).
     fixed_roots: Vec<f64>,
-    /// Per term: `side (κ/Y*)/(1 + α²)`, `α = κηS/Y*` with S the slip shape at the point.
+    /// Per term: `side (κ/Y*)/(1 + α²)`, `α = κηS/Y*` with S the slip sign beside the point
+    /// when its root formed ([`pressure_root`]).
     pressure_factor: Vec<f64>,
     /// Per term: `(κ/Y*) η² S²`, the factor of p's stick-side root in w's relation.
     stick_side: Vec<f64>,
@@ -545,58 +590,46 @@ struct KinkMaps {
     cauchy_at_pressure: RowMatrix,
     cauchy_at_charge: RowMatrix,
     cauchy_at_stick: RowMatrix,
+    at_stick: RowMatrix,
     at_samples: RowMatrix,
     at_nodes: RowMatrix,
 }
 
 impl KinkMaps {
-    /// The maps for the terms `points` (`(point, side, root)`, the root used only for the
+    /// The maps for the terms `points` (`(point, side, root, sign)`, the root used only for the
     /// remembered ones) on `state`'s geometry; `coefficients` are κ/Y*, w13/y33 and η.
     ///
-    /// A stretch narrower than the grid spacing at the contact ends, `a (π/M)²`, holds no
-    /// collocation point; its term is switched off smoothly (smootherstep between one and two
-    /// spacings): unresolved, it only disturbed the search for the first state after a
-    /// reversal, whose edge slip zones start that thin (insulating Figure-3 history: a left
-    /// slip zone of 8e−5 a).
+    /// A term on a stretch the grid does not resolve is switched off ([`resolved`]):
+    /// unresolved, it only disturbed the search for the first state after a reversal, whose
+    /// edge slip zones start that thin (insulating Figure-3 history: a left slip zone of
+    /// 8e−5 a).
     fn new(
         state: &ContactState,
-        points: &[(f64, f64, f64)],
+        points: &[(f64, f64, f64, f64)],
         at: KinkPoints<'_>,
         m: usize,
         coefficients: [f64; 3],
     ) -> Self {
         let [kappa, charge, eta] = coefficients;
         let (c, a) = (state.centre, state.half_width);
-        let spacing = a * (std::f64::consts::PI / m as f64).powi(2);
         let domains: Vec<(f64, f64)> = points
             .iter()
-            .map(|&(x0, side, _)| kink_domain(x0, side, c, a))
-            .collect();
-        let shape: Vec<f64> = points
-            .iter()
-            .enumerate()
-            .map(|(j, &(x0, _, _))| match j {
-                0 => state.traction.left_sign,
-                1 => state.traction.right_sign,
-                _ => state.slip_shape(x0),
-            })
+            .map(|&(x0, side, _, _)| kink_domain(x0, side, c, a))
             .collect();
         let pressure_factor = points
             .iter()
-            .zip(&shape)
-            .map(|(&(_, side, _), s)| {
-                let alpha = kappa * eta * s;
-                side * kappa / (1.0 + alpha * alpha)
-            })
+            .map(|&(_, side, _, sign)| pressure_root(side, kappa, eta, sign, 1.0))
             .collect();
-        let stick_side = shape.iter().map(|s| kappa * eta * eta * s * s).collect();
+        let stick_side = points
+            .iter()
+            .map(|&(_, _, _, sign)| kappa * eta * eta * sign * sign)
+            .collect();
         let to_amplitude = domains
             .iter()
             .map(|&(u, v)| {
-                let length = v - u;
-                let resolved = smootherstep(length / spacing - 1.0);
-                if resolved > 0.0 {
-                    resolved * a / length.sqrt()
+                let blend = resolved(v - u, a, m);
+                if blend > 0.0 {
+                    blend * a / (v - u).sqrt()
                 } else {
                     0.0
                 }
@@ -620,8 +653,8 @@ impl KinkMaps {
             _ => Vec::new(),
         };
         Self {
-            points: points.iter().map(|&(x0, side, _)| (x0, side)).collect(),
-            fixed_roots: points.iter().skip(2).map(|&(_, _, k)| k).collect(),
+            points: points.iter().map(|&(x0, side, _, _)| (x0, side)).collect(),
+            fixed_roots: points.iter().skip(2).map(|&(_, _, k, _)| k).collect(),
             pressure_factor,
             stick_side,
             to_amplitude,
@@ -629,6 +662,7 @@ impl KinkMaps {
             cauchy_at_pressure: table(at.pressure, &half_ellipse_cauchy),
             cauchy_at_charge: table(at.charge, &half_ellipse_cauchy),
             cauchy_at_stick: table(at.stick, &half_ellipse_cauchy),
+            at_stick: table(at.stick, &half_ellipse),
             at_samples: table(at.samples, &half_ellipse),
             at_nodes: table(&nodes, &half_ellipse),
         }
@@ -702,8 +736,8 @@ const END_PROBE: f64 = 0.01;
 struct EndProbes {
     /// Density rows of the own series at `lo + d`, `lo + 2d`, `hi − d`, `hi − 2d`.
     rows: [Vec<f64>; 4],
-    /// The inherited correction at the same points.
-    inherited: [f64; 4],
+    /// The closed-form part of q̃ (inherited chain and extras) at the same points.
+    closed: [f64; 4],
     /// The same points (m).
     points: [f64; 4],
     /// d (m).
@@ -713,7 +747,7 @@ struct EndProbes {
 }
 
 impl EndProbes {
-    fn new(g: &Geometry, m: usize, inherited: Option<&Inherited>) -> Self {
+    fn new(g: &Geometry, m: usize, closed: &StickZone) -> Self {
         let half = 0.5 * (g.hi - g.lo);
         let d = END_PROBE * half;
         let points = [g.lo + d, g.lo + 2.0 * d, g.hi - d, g.hi - 2.0 * d];
@@ -724,7 +758,7 @@ impl EndProbes {
         });
         Self {
             rows,
-            inherited: points.map(|x| inherited.map_or(0.0, |z| z.value(x))),
+            closed: points.map(|x| closed.correction_at(x)),
             points,
             d,
             scale: half.sqrt(),
@@ -740,7 +774,7 @@ impl EndProbes {
 
     /// The scaled coefficients of the q̃ whose own series is `beta`.
     fn scaled_roots_of(&self, beta: &[f64]) -> [f64; 2] {
-        let mut v = self.inherited;
+        let mut v = self.closed;
         for (vi, row) in v.iter_mut().zip(&self.rows) {
             *vi += dot(row, beta);
         }
