@@ -1497,6 +1497,29 @@ mod tests {
         assert!(worst < 1e-11, "worst relative difference {worst:e}");
     }
 
+    /// The half-ellipse on `[u, v]` is the n = 1 term of a bounded series on that interval
+    /// (β_1 = h, τ = (x − m)/h): its values, Cauchy transform (inside and on both sides
+    /// outside) and integral (h times the series' ∫ dτ) against the series' own formulas (tested against brute-force quadrature in
+    /// the quadrature module).
+    #[test]
+    fn half_ellipse_is_the_first_bounded_term() {
+        let (u, v) = (-0.3, 0.9);
+        let (m, h) = (0.5 * (u + v), 0.5 * (v - u));
+        let series = BoundedSeries { beta: vec![h] };
+        for x in [-2.0, -0.31, -0.2, 0.1, 0.5, 0.89, 0.95, 3.0] {
+            let t = (x - m) / h;
+            assert!(
+                (half_ellipse(x, u, v) - series.density(t)).abs() < 1e-15,
+                "{x}"
+            );
+            assert!(
+                (half_ellipse_cauchy(x, u, v) - series.cauchy(t)).abs() < 1e-15,
+                "{x}"
+            );
+        }
+        assert!((half_ellipse_integral(u, v) - h * series.integral()).abs() < 1e-15);
+    }
+
     #[test]
     fn log_moment_matches_hand_integrals() {
         // ∫_{−1}^{1} ln|s| ds = −2; ∫_{−1}^{1} ln(2 − s) ds = ∫_1^3 ln r dr = 3 ln 3 − 2;
