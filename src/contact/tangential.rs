@@ -284,8 +284,8 @@ impl StepProblem<'_> {
             .flatten();
         let w13_over_y33 = electric.map_or(0.0, |e| e.w13 / e.y33);
         let coupled = kappa.abs() > 0.0 || w13_over_y33.abs() > 0.0;
-        // The remembered stick ends inside the zone, `(point, side, root, sign)`, and the parts
-        // of q̃ that carry their kinks (module docs, "Kinks at the stick ends").
+        // The remembered stick ends inside the zone and the parts of q̃ that carry their kinks
+        // beyond them (module docs, "Kinks at the stick ends").
         let interior = match (&inherited, coupled) {
             (Some(z), true) => z.interior_roots(g.lo, g.hi),
             _ => Vec::new(),
@@ -405,7 +405,7 @@ impl StepProblem<'_> {
             KinkMaps::default()
         };
         // The inner unknown: q at the pressure points, then at the charge points, then (when
-        // coupled) q̃'s end coefficients.
+        // coupled) q̃'s root coefficients at the new ends, times √h (Pa).
         let mut x: Vec<f64> = sample_points
             .iter()
             .map(|&x| guess.traction_at(x))
@@ -462,7 +462,7 @@ impl StepProblem<'_> {
                 state.charge = charge;
                 state.potential = potential;
                 let free = charge - model.pressure_charge(self.normal_load);
-                w_amp = kinks.charge_amplitudes(&roots, &amp);
+                w_amp = kinks.charge_amplitudes(&roots);
                 state.charge_kinks = kinks.kinks(&w_amp);
                 for (r, q) in crhs.iter_mut().zip(&x[np..np + nc]) {
                     *r = -e.w13 / e.y33 * q;
@@ -521,16 +521,13 @@ impl StepProblem<'_> {
                 stick.end_roots = ends;
             }
             let p0 = state.pressure_at(g.c).abs().max(1e-300);
-            let largest_change = |from: usize, to: usize| {
-                fx[from..to]
-                    .iter()
-                    .zip(&x[from..to])
-                    .map(|(n, o)| (n - o).abs())
-                    .fold(0.0, f64::max)
-                    / (eta * p0)
-            };
-            let converged = largest_change(0, x.len()) < 1e-14;
-            if kappa == 0.0 && !split.conducting || converged {
+            let change = fx
+                .iter()
+                .zip(&x)
+                .map(|(n, o)| (n - o).abs())
+                .fold(0.0, f64::max)
+                / (eta * p0);
+            if kappa == 0.0 && !split.conducting || change < 1e-14 {
                 break;
             }
             accel.next(&mut x, &fx);
@@ -723,19 +720,16 @@ impl KinkMaps {
             .collect()
     }
 
-    /// The amplitudes of w's kinks, `B = side (w13/y33)(k − side (κ/Y*) η² S² A)` for p's
-    /// amplitudes `p_amp` (q = ηSp + q̃ carries p's stick-side root −side α A next to q̃'s).
-    fn charge_amplitudes(&self, roots: &[f64], p_amp: &[f64]) -> Vec<f64> {
+    /// The amplitudes of w's kinks, `B = side (w13/y33)(k − side (κ/Y*) η² S² A)` with p's
+    /// root A (q = ηSp + q̃ carries p's stick-side root −side α A next to q̃'s).
+    fn charge_amplitudes(&self, roots: &[f64]) -> Vec<f64> {
         roots
             .iter()
-            .zip(p_amp)
             .enumerate()
-            .map(|(j, (k, amp))| {
+            .map(|(j, k)| {
                 let side = self.points[j].1;
-                let t = self.to_amplitude[j];
-                // p's root from its amplitude (t = 0 switches the term off either way).
-                let root_p = if t > 0.0 { amp / t } else { 0.0 };
-                side * self.charge * (k - side * self.stick_side[j] * root_p) * t
+                let root_p = self.pressure_factor[j] * k;
+                side * self.charge * (k - side * self.stick_side[j] * root_p) * self.to_amplitude[j]
             })
             .collect()
     }
