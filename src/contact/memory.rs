@@ -133,20 +133,6 @@ impl Memory {
         found
     }
 
-    /// The points where the remembered strain is not smooth: the pieces' ends, the stick ends
-    /// and chain points of the remembered states, and the centre kink `C|x|` of a normal
-    /// loading's memory.
-    pub fn feature_points(&self) -> Vec<f64> {
-        let mut points = self.breakpoints();
-        for p in &self.pieces {
-            match p.source.as_ref() {
-                StrainSource::Linear { .. } => points.push(0.0),
-                StrainSource::State { state } => points.extend(state.traction_breakpoints()),
-            }
-        }
-        points
-    }
-
     /// The interior breakpoints (old stick/slip boundaries), for output.
     pub fn breakpoints(&self) -> Vec<f64> {
         self.pieces.iter().skip(1).map(|p| p.lo).collect()

@@ -734,7 +734,7 @@ impl StickZone {
     /// Where q̃ may fail to be smooth besides the zone's ends: the ends of the zones in its
     /// chain (square roots), their fade ramps, and centre kinks (see [`kink_density`]); not
     /// filtered to the zone.
-    pub(crate) fn chain_points(&self) -> Vec<f64> {
+    fn chain_points(&self) -> Vec<f64> {
         let mut points: Vec<f64> = self.kink_point().into_iter().collect();
         for i in self.links() {
             points.extend([i.zone.lo, i.zone.hi]);

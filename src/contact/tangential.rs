@@ -381,7 +381,7 @@ impl StepProblem<'_> {
         // iteration, estimated from q̃ at `END_PROBE` and twice that of the half-width inside
         // each end (see `EndProbes`), and at the remembered stick ends inside the zone, whose
         // roots the chain carries.
-        let probes = EndProbes::new(g, m, &closed, self.memory);
+        let probes = EndProbes::new(g, m, &closed);
         let kinks = if coupled {
             let mut points = vec![
                 (g.lo, -1.0, 0.0, self.signs.0),
@@ -770,44 +770,17 @@ struct EndProbes {
     closed: [f64; 4],
     /// The same points (m).
     points: [f64; 4],
-    /// d at the left and right end (m).
-    d: [f64; 2],
-    /// The weight of each end's root: 1 where d spans two node spacings or more, fading to 0
-    /// at one spacing.
-    trust: [f64; 2],
+    /// d (m).
+    d: f64,
     /// √h.
     scale: f64,
 }
 
 impl EndProbes {
-    fn new(g: &Geometry, m: usize, closed: &StickZone, memory: &Memory) -> Self {
+    fn new(g: &Geometry, m: usize, closed: &StickZone) -> Self {
         let half = 0.5 * (g.hi - g.lo);
-        // The probes stay clear of the points where q̃ is not smooth (the chain's old stick
-        // ends, centre kinks and fade ramps, and the memory's features, which the own series
-        // absorbs) next to an end: `2d` at most two thirds of the way to the nearest.
-        let slack = 1e-9 * half;
-        let mut gaps = [f64::INFINITY; 2];
-        for x in closed
-            .chain_points()
-            .into_iter()
-            .chain(memory.feature_points())
-        {
-            if x > g.lo + slack && x < g.hi - slack {
-                gaps[0] = gaps[0].min(x - g.lo);
-                gaps[1] = gaps[1].min(g.hi - x);
-            }
-        }
-        // d is at least two node spacings of the zone's series at its ends, `h (π/M)²`, and a
-        // root read closer than two spacings (an end next to a break point) is faded out.
-        let spacing = half * (std::f64::consts::PI / m as f64).powi(2);
-        let d = gaps.map(|gap| (END_PROBE * half).max(2.0 * spacing).min(gap / 3.0));
-        let trust = d.map(|d| smootherstep(d / spacing - 1.0));
-        let points = [
-            g.lo + d[0],
-            g.lo + 2.0 * d[0],
-            g.hi - d[1],
-            g.hi - 2.0 * d[1],
-        ];
+        let d = END_PROBE * half;
+        let points = [g.lo + d, g.lo + 2.0 * d, g.hi - d, g.hi - 2.0 * d];
         let rows = points.map(|x| {
             let mut row = vec![0.0; m];
             BoundedSeries::density_row((x - 0.5 * (g.lo + g.hi)) / half, &mut row);
@@ -818,20 +791,15 @@ impl EndProbes {
             closed: points.map(|x| closed.correction_at(x)),
             points,
             d,
-            trust,
             scale: half.sqrt(),
         }
     }
 
     /// `[k_lo, k_hi]` times `scale` from q̃ at the four points.
     fn extrapolate(&self, v: [f64; 4]) -> [f64; 2] {
-        let root = |near: f64, far: f64, d: f64| {
-            (2.0 * near / d.sqrt() - far / (2.0 * d).sqrt()) * self.scale
-        };
-        [
-            self.trust[0] * root(v[0], v[1], self.d[0]),
-            self.trust[1] * root(v[2], v[3], self.d[1]),
-        ]
+        let (r1, r2) = (self.d.sqrt(), (2.0 * self.d).sqrt());
+        let root = |near: f64, far: f64| (2.0 * near / r1 - far / r2) * self.scale;
+        [root(v[0], v[1]), root(v[2], v[3])]
     }
 
     /// The scaled coefficients of the q̃ whose own series is `beta`.
