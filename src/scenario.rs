@@ -195,6 +195,13 @@ pub struct RawNumerics {
     /// (0 < tol < 1, default 1e−6).
     #[serde(default = "default_cycle_tolerance")]
     pub cycle_tolerance: f64,
+    /// Carry the square-root kinks of p and w at the stick ends in closed form (default true).
+    #[serde(default = "default_stick_end_kinks")]
+    pub stick_end_kinks: bool,
+}
+
+fn default_stick_end_kinks() -> bool {
+    true
 }
 
 fn default_cycle_tolerance() -> f64 {
@@ -210,6 +217,7 @@ impl Default for RawNumerics {
         Self {
             collocation_points: default_m(),
             cycle_tolerance: default_cycle_tolerance(),
+            stick_end_kinks: default_stick_end_kinks(),
         }
     }
 }
@@ -480,7 +488,8 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
         (Some(material), Some(electrode), true) => {
             let model = ContactModel::new(material, raw.punch.radius, raw.friction, electrode)
                 .with_reference_distance(raw.reference_distance)
-                .with_coupling(raw.coupling);
+                .with_coupling(raw.coupling)
+                .with_stick_end_kinks(raw.numerics.stick_end_kinks);
             // Splitting a segment moves its steps, so repeat until every snapshot time is a
             // step time (each time is added at most once).
             let history = history.map(|mut h| {

@@ -117,6 +117,10 @@ pub struct ContactModel {
     pub reference_distance: f64,
     /// Shear–pressure coupling.
     pub coupling: Coupling,
+    /// Whether p and w carry their square-root kinks at the stick ends in closed form
+    /// ([`Kinks`]; default on). Off gives the plain series of the seed paper: slower
+    /// convergence in M, but it completes two histories that the kinks stop (README).
+    pub stick_end_kinks: bool,
 }
 
 /// How the charge is split, `g = χ p + w`.
@@ -140,7 +144,14 @@ impl ContactModel {
             electrode,
             reference_distance: 1e-2,
             coupling: Coupling::Full,
+            stick_end_kinks: true,
         }
+    }
+
+    /// With the kinks at the stick ends on or off.
+    pub fn with_stick_end_kinks(mut self, on: bool) -> Self {
+        self.stick_end_kinks = on;
+        self
     }
 
     /// With a datum distance d (m).

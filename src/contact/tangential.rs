@@ -283,7 +283,7 @@ impl StepProblem<'_> {
             .then_some(model.compliance.electric)
             .flatten();
         let w13_over_y33 = electric.map_or(0.0, |e| e.w13 / e.y33);
-        let coupled = kappa.abs() > 0.0 || w13_over_y33.abs() > 0.0;
+        let coupled = model.stick_end_kinks && (kappa.abs() > 0.0 || w13_over_y33.abs() > 0.0);
         // The remembered stick ends inside the zone and the parts of q̃ that carry their kinks
         // beyond them (module docs, "Kinks at the stick ends").
         let interior = match (&inherited, coupled) {

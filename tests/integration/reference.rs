@@ -1059,6 +1059,27 @@ fn default_history_stick_ends_and_work_converge_in_m() {
     assert!(work < 3e-4, "{work:e}");
 }
 
+/// The kinks switched off (`numerics.stick_end_kinks = false`): the plain series of the seed
+/// paper, which completes the Figure-3 history at M = 32 (with the kinks that run stops at
+/// step 2 on the stick check, README known limitations); no state carries a kink.
+#[test]
+fn figure3_history_completes_without_the_stick_end_kinks() {
+    let mut b = baseline(32);
+    b.model = b.model.with_stick_end_kinks(false);
+    let lim = b.lim;
+    let points: Vec<(f64, f64)> = [0.0, 0.3, 0.5, 0.3, 0.0, -0.3, -0.5]
+        .iter()
+        .enumerate()
+        .map(|(i, q)| (i as f64, q * lim))
+        .collect();
+    let run = run_points(&b.model, &b.disc, &b.normal, points, 10, 0.05 * lim);
+    assert_eq!(run.records.len(), 61);
+    let s = &run.driver.state;
+    assert!(s.pressure_kinks.0.is_empty() && s.charge_kinks.0.is_empty());
+    let zone = s.traction.stick.as_ref().unwrap();
+    assert!(zone.extras.is_empty() && zone.end_roots == [0.0; 2]);
+}
+
 /// Masing's memory in the coupled contact (PZT-4 baseline, M = 64), the partial
 /// unload–reload history 0 → 0.5 → 0.1 → 0.5 → 0.7 ηP (five steps per segment, at most
 /// 0.1 ηP; the monotonic path in steps of 0.1 ηP): on returning to
