@@ -92,6 +92,17 @@ fn run_points(
     .unwrap()
 }
 
+/// The default history's load points: 0 → +½ ηP at t = 1, then `turns − 1` more turning
+/// points alternating −½, +½ ηP two seconds apart (`limit` = ηP).
+fn half_amplitude_cycles(limit: f64, turns: usize) -> Vec<(f64, f64)> {
+    let mut points = vec![(0.0, 0.0)];
+    for k in 0..turns {
+        let sign = if k % 2 == 0 { 0.5 } else { -0.5 };
+        points.push((1.0 + 2.0 * k as f64, sign * limit));
+    }
+    points
+}
+
 /// The state after ramping Q from 0 to `fraction` ηP in steps of 0.1 ηP (at least
 /// `steps_per_segment`) from the end of normal loading.
 fn ramped_state(
@@ -937,13 +948,7 @@ fn coupled_cycle_masing_return_and_step_refinement() {
     use fretsim::history::StepRecord;
     let runs = [baseline(48), baseline(64)];
     let lim = runs[0].lim;
-    let points = vec![
-        (0.0, 0.0),
-        (1.0, 0.5 * lim),
-        (3.0, -0.5 * lim),
-        (5.0, 0.5 * lim),
-        (7.0, -0.5 * lim),
-    ];
+    let points = half_amplitude_cycles(lim, 4);
     let turning = |recs: &[StepRecord]| -> Vec<StepRecord> {
         recs.iter()
             .filter(|r| (r.q.abs() - 0.5 * lim).abs() < 1e-9 * lim)
@@ -1019,14 +1024,7 @@ fn coupled_cycle_masing_return_and_step_refinement() {
 #[test]
 fn default_history_stick_ends_and_work_converge_in_m() {
     let lim = baseline(64).lim;
-    let points = vec![
-        (0.0, 0.0),
-        (1.0, 0.5 * lim),
-        (3.0, -0.5 * lim),
-        (5.0, 0.5 * lim),
-        (7.0, -0.5 * lim),
-        (9.0, 0.5 * lim),
-    ];
+    let points = half_amplitude_cycles(lim, 5);
     let mut runs = Vec::new();
     for m in [64, 128] {
         let b = baseline(m);
