@@ -80,6 +80,17 @@ impl RowMatrix {
             *yi = dot(self.row(i), x);
         }
     }
+
+    /// `y += factor · A x`; nothing for a matrix without rows (an absent map).
+    pub fn add_apply(&self, x: &[f64], factor: f64, y: &mut [f64]) {
+        if self.rows() == 0 {
+            return;
+        }
+        debug_assert_eq!(x.len(), self.cols);
+        for (i, yi) in y.iter_mut().enumerate() {
+            *yi += factor * dot(self.row(i), x);
+        }
+    }
 }
 
 /// The M × M transform (row-major) times the first M rows of `inverse`, as a matrix with

@@ -335,6 +335,13 @@ impl PartialEq for Inherited {
     }
 }
 
+/// The slip shape between the signs `[left, right]` beside a stick zone `[lo, hi]`:
+/// `s_L + (s_R − s_L)(3v² − 2v³)`, `v = (x − lo)/(hi − lo)` clamped to [0, 1].
+fn sign_blend([left, right]: [f64; 2], lo: f64, hi: f64, x: f64) -> f64 {
+    let v = ((x - lo) / (hi - lo)).clamp(0.0, 1.0);
+    left + (right - left) * v * v * (3.0 - 2.0 * v)
+}
+
 pub(crate) fn smootherstep(v: f64) -> f64 {
     let v = v.clamp(0.0, 1.0);
     v * v * v * (v * (6.0 * v - 15.0) + 10.0)
@@ -570,9 +577,7 @@ impl StickZone {
     /// The slip-shape S at x from the slip signs beside the ends when the zone was solved
     /// (the smoothstep of [`ContactState::slip_shape`]).
     pub fn end_sign_shape(&self, x: f64) -> f64 {
-        let v = ((x - self.lo) / (self.hi - self.lo)).clamp(0.0, 1.0);
-        let [l, r] = self.end_signs;
-        l + (r - l) * v * v * (3.0 - 2.0 * v)
+        sign_blend(self.end_signs, self.lo, self.hi, x)
     }
 
     /// Tabulate `H'q̃` (see `CauchyTable`) for a zone that will be evaluated many times (one
@@ -929,10 +934,7 @@ impl ContactState {
             None => 0.0,
             Some(s) if x <= s.lo => t.left_sign,
             Some(s) if x >= s.hi => t.right_sign,
-            Some(s) => {
-                let v = (x - s.lo) / (s.hi - s.lo);
-                t.left_sign + (t.right_sign - t.left_sign) * v * v * (3.0 - 2.0 * v)
-            }
+            Some(s) => sign_blend([t.left_sign, t.right_sign], s.lo, s.hi, x),
         }
     }
 
@@ -1510,8 +1512,8 @@ mod tests {
 
     /// The half-ellipse on `[u, v]` is the n = 1 term of a bounded series on that interval
     /// (β_1 = h, τ = (x − m)/h): its values, Cauchy transform (inside and on both sides
-    /// outside) and integral (h times the series' ∫ dτ) against the series' own formulas (tested against brute-force quadrature in
-    /// the quadrature module).
+    /// outside) and integral (h times the series' ∫ dτ) against the series' own formulas,
+    /// which the quadrature module tests against brute-force quadrature.
     #[test]
     fn half_ellipse_is_the_first_bounded_term() {
         let (u, v) = (-0.3, 0.9);

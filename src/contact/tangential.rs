@@ -396,7 +396,7 @@ impl StepProblem<'_> {
                     charge: &charge_points[..nc],
                     stick: &stick_points,
                     samples: &sample_points,
-                    mixed,
+                    nodes: &maps.node_points,
                 },
                 m,
                 [kappa / ystar, w13_over_y33, eta],
@@ -441,7 +441,7 @@ impl StepProblem<'_> {
             for ((r, &xp), q) in rhs.iter_mut().zip(&pressure_points).zip(&x[..np]) {
                 *r = -xp * scale - kappa / ystar * q;
             }
-            add_product(&kinks.cauchy_at_pressure, &amp, -1.0, &mut rhs);
+            kinks.cauchy_at_pressure.add_apply(&amp, -1.0, &mut rhs);
             lambda_p = disc.bounded.solve_coefficients(&rhs, &mut beta_p);
             state.pressure.beta.clone_from(&beta_p);
             state.pressure_kinks = kinks.kinks(&amp);
@@ -467,7 +467,7 @@ impl StepProblem<'_> {
                 for (r, q) in crhs.iter_mut().zip(&x[np..np + nc]) {
                     *r = -e.w13 / e.y33 * q;
                 }
-                add_product(&kinks.cauchy_at_charge, &w_amp, -1.0, &mut crhs);
+                kinks.cauchy_at_charge.add_apply(&w_amp, -1.0, &mut crhs);
                 let kinks_force =
                     state.potential_charge_force() - g.a * state.potential_charge.integral();
                 disc.unbounded
@@ -478,11 +478,11 @@ impl StepProblem<'_> {
             // zones have the same sign s.
             maps.stick_from_p.apply(&beta_p, &mut srhs);
             if let Some(eta_s) = maps.shape {
-                add_product(&kinks.cauchy_at_stick, &amp, -eta_s, &mut srhs);
+                kinks.cauchy_at_stick.add_apply(&amp, -eta_s, &mut srhs);
             }
             // The remembered kinks' terms reach into the stick zone: their local parts.
-            add_product(&kinks.at_stick, &amp, local / y11, &mut srhs);
-            add_product(&kinks.at_stick, &w_amp, w13 / y11, &mut srhs);
+            kinks.at_stick.add_apply(&amp, local / y11, &mut srhs);
+            kinks.at_stick.add_apply(&w_amp, w13 / y11, &mut srhs);
             if split.conducting {
                 maps.stick_from_w.apply(&gamma, &mut work);
                 for (r, w) in srhs.iter_mut().zip(&work) {
@@ -492,8 +492,8 @@ impl StepProblem<'_> {
             if mixed {
                 maps.cauchy_at_stick.apply(&beta_p, &mut work);
                 maps.shape_nodes.apply(&beta_p, &mut p_nodes);
-                add_product(&kinks.cauchy_at_stick, &amp, 1.0, &mut work);
-                add_product(&kinks.at_nodes, &amp, 1.0, &mut p_nodes);
+                kinks.cauchy_at_stick.add_apply(&amp, 1.0, &mut work);
+                kinks.at_nodes.add_apply(&amp, 1.0, &mut p_nodes);
                 for (i, r) in srhs.iter_mut().enumerate() {
                     let shape =
                         maps.stick_shape[i] * work[i] + dot(maps.shape_weights.row(i), &p_nodes);
@@ -564,16 +564,6 @@ struct Coefficients {
     charge: Option<f64>,
 }
 
-/// `y += factor · A x` (nothing when A has no rows).
-fn add_product(a: &RowMatrix, x: &[f64], factor: f64, y: &mut [f64]) {
-    if a.rows() == 0 {
-        return;
-    }
-    for (i, yi) in y.iter_mut().enumerate() {
-        *yi += factor * dot(a.row(i), x);
-    }
-}
-
 /// p's square-root coefficient on the slip side of a kink point, `side (κ/Y*) k/(1 + α²)`,
 /// `α = κηS/Y*`, for q̃'s root k there and the slip sign S (module docs).
 fn pressure_root(side: f64, kappa: f64, eta: f64, sign: f64, k: f64) -> f64 {
@@ -595,8 +585,8 @@ struct KinkPoints<'a> {
     charge: &'a [f64],
     stick: &'a [f64],
     samples: &'a [f64],
-    /// Whether the slip signs differ (the shape quadrature needs p at its nodes).
-    mixed: bool,
+    /// The shape quadrature's nodes (mixed slip signs only: `H'(pS)` needs p there).
+    nodes: &'a [f64],
 }
 
 /// The kink terms of one evaluation (tangential module docs, "Kinks at the stick ends"): their
@@ -677,14 +667,6 @@ impl KinkMaps {
             }
             out
         };
-        let nodes: Vec<f64> = match (&state.traction.stick, at.mixed) {
-            (Some(stick), true) => state
-                .shape_quadrature(stick)
-                .iter()
-                .map(|&(t, _, _)| t)
-                .collect(),
-            _ => Vec::new(),
-        };
         Self {
             points: points.iter().map(|&(x0, side, _, _)| (x0, side)).collect(),
             fixed_roots: points.iter().skip(2).map(|&(_, _, k, _)| k).collect(),
@@ -697,7 +679,7 @@ impl KinkMaps {
             cauchy_at_stick: table(at.stick, &half_ellipse_cauchy),
             at_stick: table(at.stick, &half_ellipse),
             at_samples: table(at.samples, &half_ellipse),
-            at_nodes: table(&nodes, &half_ellipse),
+            at_nodes: table(at.nodes, &half_ellipse),
         }
     }
 
@@ -836,6 +818,8 @@ struct InnerMaps {
     stick_shape: Vec<f64>,
     /// `η s` of [`Coefficients::shape`].
     shape: Option<f64>,
+    /// The positions of the shape quadrature's nodes (mixed slip signs only).
+    node_points: Vec<f64>,
 }
 
 impl InnerMaps {
@@ -884,8 +868,10 @@ impl InnerMaps {
         for (j, &xq) in sample_points.iter().enumerate() {
             BoundedSeries::density_row((xq - mid) / half, own_at_samples.row_mut(j));
         }
+        let mut node_points = Vec::new();
         let (shape_nodes, shape_weights) = if k.shape.is_none() {
             let table = state.shape_quadrature(stick);
+            node_points = table.iter().map(|&(t, _, _)| t).collect();
             let mut at_nodes = RowMatrix::zeros(table.len(), m);
             for (j, &(t, _, _)) in table.iter().enumerate() {
                 BoundedSeries::density_row((t - c) / a, at_nodes.row_mut(j));
@@ -911,6 +897,7 @@ impl InnerMaps {
             shape_weights,
             stick_shape,
             shape: k.shape,
+            node_points,
         }
     }
 }
