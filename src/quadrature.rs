@@ -58,6 +58,14 @@ impl RowMatrix {
         }
     }
 
+    /// Make this a `rows × cols` matrix of zeros, keeping the allocation (a matrix rebuilt at
+    /// every residual evaluation would otherwise be mapped afresh by the allocator).
+    pub fn reset(&mut self, rows: usize, cols: usize) {
+        self.cols = cols;
+        self.data.clear();
+        self.data.resize(rows * cols, 0.0);
+    }
+
     /// Number of rows.
     pub fn rows(&self) -> usize {
         self.data.len().checked_div(self.cols).unwrap_or(0)

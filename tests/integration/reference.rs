@@ -456,10 +456,12 @@ fn friction_limits_tend_to_frictionless_and_to_full_stick() {
 /// Every correction in this limit is `const·√(c² − x²)` on a stick zone, which the bounded
 /// representation holds exactly, and each phase inherits the previous corrections in closed
 /// form, so the whole history is reproduced to the solver tolerance at every M (measured:
-/// |Δc|/a = 2.7e−15, 1.1e−14, 1.2e−14 and |Δq|/(ηp0) = 1.5e−8, 4.1e−8, 7.7e−8 for M = 32, 64,
-/// 128, round-off of the Chebyshev sums growing with M). Without the inheritance the memory's
-/// square-root kinks at the old stick ends limited this to first order (|Δc|/a = 7e−3, 4e−3,
-/// 2e−3): the tolerances below would catch that regression.
+/// |Δc|/a = 5.7e−14, 5.9e−14, 5.9e−14 and, away from the stick ends, |Δq|/(ηp0) = 6.2e−13,
+/// 6.7e−13, 6.8e−13 for M = 32, 64, 128). At a point on a stick end q̃ starts like a square
+/// root, so it sees √(Δc): 1.2e−7 ηp0 at step 34 (c = a/2 falls on the sample grid), which an
+/// earlier version of this test took for the round-off of the Chebyshev sums. Without the
+/// inheritance the memory's square-root kinks at the old stick ends limited this to first
+/// order (|Δc|/a = 7e−3, 4e−3, 2e−3): the tolerances below would catch that regression.
 #[test]
 fn reference_cattaneo_mindlin_deresiewicz_masing() {
     use fretsim::contact::normal::{NormalOptions, solve_normal};
@@ -527,14 +529,21 @@ fn reference_cattaneo_mindlin_deresiewicz_masing() {
                     .max((rec.stick_lo + c_exact).abs())
                     / a,
             );
+            // Not at the stick ends themselves: q̃ starts like √(c − |x|) there, so a point
+            // on an end sees the square root of the end's round-off (Δc = 1.4e−14 a gives
+            // 1.2e−7 ηp0); the ends are checked by Δc.
+            let near_end =
+                |x: f64| (x - rec.stick_lo).abs().min((x - rec.stick_hi).abs()) < 1e-6 * a;
             for i in 1..100 {
                 let x = a * (-1.0 + 2.0 * i as f64 / 100.0);
-                err_q = err_q.max((state.traction_at(x) - traction(x)).abs() / scale);
+                if !near_end(x) {
+                    err_q = err_q.max((state.traction_at(x) - traction(x)).abs() / scale);
+                }
             }
         }
         eprintln!("CM/MD/Masing M = {m}: max |Δc|/a = {err_c:.2e}, max |Δq|/(ηp0) = {err_q:.2e}");
         assert!(
-            err_c < 1e-10 && err_q < 1e-7,
+            err_c < 1e-12 && err_q < 5e-12,
             "M = {m}: {err_c:e}, {err_q:e}"
         );
     }
