@@ -364,8 +364,7 @@ impl Inherited {
 
     fn table(&self) -> &FadeTable {
         self.table.get_or_init(|| {
-            let rule = graded_rule_with(FADE_NODES);
-            let (nodes, weights) = (&rule.nodes, &rule.weights);
+            let (nodes, weights) = graded_rule();
             let mut all = Vec::new();
             for w in self.pieces().windows(2) {
                 let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
@@ -1171,12 +1170,6 @@ fn graded_rule_with(nodes: usize) -> &'static GradedRule {
 
 /// Nodes per piece of the graded rule of [`graded_rule`].
 const GRADED_NODES: usize = 96;
-
-/// Nodes per piece of the fade integral of an [`Inherited`] (built at every residual
-/// evaluation of a step whose zone ends inside the inherited one). Measured against
-/// [`GRADED_NODES`]: the stick ends of the insulating Figure-3 history within 5.5e−11 a, the
-/// default run's within 1e−16 a (32 nodes: 2.4e−6 a); the default run 3 % faster.
-const FADE_NODES: usize = 48;
 
 /// A sine-graded Gauss–Legendre rule on [−1, 1] (`u = sin(πv/2)`, see [`graded_rule`]) with
 /// its cumulative matrix.
