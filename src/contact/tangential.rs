@@ -891,7 +891,6 @@ impl InnerMaps {
         let (c, a) = (state.centre, state.half_width);
         let stick = state.traction.stick.as_ref().expect("stick zone set");
         let rows = stick_points.len();
-        let mut row = vec![0.0; m];
         let Self {
             stick_from_p,
             stick_from_w,
@@ -901,46 +900,48 @@ impl InnerMaps {
             shape_weights,
             ..
         } = self;
+        // The stick points lie inside the contact, where `cauchy_row` is the T recurrence.
+        let taus: Vec<f64> = stick_points.iter().map(|&xs| (xs - c) / a).collect();
+        debug_assert!(taus.iter().all(|t| t.abs() < 1.0));
         stick_from_p.reset(rows, m);
+        stick_from_p.fill_recurrence_rows(0, &taus, |t| {
+            let [prev, first, scale] = BoundedSeries::density_start(t);
+            [prev, first, k.local_over_y11 * scale]
+        });
+        cauchy_at_stick.reset(rows, m);
+        cauchy_at_stick.fill_recurrence_rows(0, &taus, BoundedSeries::cauchy_start_inside);
+        if let Some(eta_s) = k.shape {
+            for i in 0..rows {
+                for (o, r) in stick_from_p
+                    .row_mut(i)
+                    .iter_mut()
+                    .zip(cauchy_at_stick.row(i))
+                {
+                    *o -= eta_s * r;
+                }
+            }
+            // Folded into `stick_from_p`; mixed slip signs only keep it apart.
+            cauchy_at_stick.reset(0, m);
+        }
         stick_from_w.reset(if k.charge.is_some() { rows } else { 0 }, m);
-        cauchy_at_stick.reset(if k.shape.is_none() { rows } else { 0 }, m);
-        for (i, &xs) in stick_points.iter().enumerate() {
-            let tau = (xs - c) / a;
-            BoundedSeries::density_row(tau, &mut row);
-            let out = stick_from_p.row_mut(i);
-            for (o, r) in out.iter_mut().zip(&row) {
-                *o = k.local_over_y11 * r;
-            }
-            BoundedSeries::cauchy_row(tau, &mut row);
-            match k.shape {
-                Some(eta_s) => {
-                    for (o, r) in out.iter_mut().zip(&row) {
-                        *o -= eta_s * r;
-                    }
-                }
-                None => cauchy_at_stick.row_mut(i).copy_from_slice(&row),
-            }
-            if let Some(w13_over_y11) = k.charge {
-                UnboundedSeries::density_row(tau, stick_from_w.row_mut(i));
-                for v in stick_from_w.row_mut(i) {
-                    *v *= w13_over_y11;
-                }
-            }
+        if let Some(w13_over_y11) = k.charge {
+            stick_from_w.fill_recurrence_rows(0, &taus, |t| {
+                let [prev, first, scale] = UnboundedSeries::density_start(t);
+                [prev, first, w13_over_y11 * scale]
+            });
         }
         let stick_shape: Vec<f64> = stick_points.iter().map(|&x| state.slip_shape(x)).collect();
         let (mid, half) = (stick.mid(), stick.half());
         own_at_samples.reset(sample_points.len(), m);
-        for (j, &xq) in sample_points.iter().enumerate() {
-            BoundedSeries::density_row((xq - mid) / half, own_at_samples.row_mut(j));
-        }
+        let sample_taus: Vec<f64> = sample_points.iter().map(|&xq| (xq - mid) / half).collect();
+        own_at_samples.fill_recurrence_rows(0, &sample_taus, BoundedSeries::density_start);
         let mut node_points = Vec::new();
         if k.shape.is_none() {
             let table = state.shape_quadrature(stick);
             node_points = table.iter().map(|&(t, _, _)| t).collect();
             shape_nodes.reset(table.len(), m);
-            for (j, &(t, _, _)) in table.iter().enumerate() {
-                BoundedSeries::density_row((t - c) / a, shape_nodes.row_mut(j));
-            }
+            let node_taus: Vec<f64> = table.iter().map(|&(t, _, _)| (t - c) / a).collect();
+            shape_nodes.fill_recurrence_rows(0, &node_taus, BoundedSeries::density_start);
             shape_weights.reset(rows, table.len());
             for (i, (&xs, &sx)) in stick_points.iter().zip(&stick_shape).enumerate() {
                 for (wij, &(t, w, st)) in shape_weights.row_mut(i).iter_mut().zip(&table) {
