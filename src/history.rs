@@ -24,7 +24,9 @@
 //! [`advance`] does the same sequentially. The records are the same either way.
 //!
 //! # Warm start
-//! Inside a phase the stick-zone ends are extrapolated linearly from the last two steps. At the
+//! Inside a phase the geometry of the step (stick ends, contact half-width and centre) is
+//! extrapolated from the last three steps by the quadratic in Q through them (`predict`), and
+//! the previous step's Jacobian starts the quasi-Newton iteration. At the
 //! start of a phase the zones that already slip in the new direction keep slipping and the
 //! others stick, with new slip zones of the Mindlin–Deresiewicz width
 //! `a(1 − √(1 − |ΔQ|/(2ηP)))` at the ends that start to slip.

@@ -395,7 +395,7 @@ fn clenshaw_pairs(c: &[f64], x: f64) -> ([f64; 2], [f64; 2]) {
     ([e1, e2], [o1, o2])
 }
 
-/// Σ c_k T_k(x) by Clenshaw's recurrence in steps of two ([`clenshaw_pairs`]; c_0 included).
+/// Σ c_k T_k(x) by Clenshaw's recurrence in steps of two (`clenshaw_pairs`; c_0 included).
 /// With `f_0, f_1` the first two members of a chain, the sum is `f_0 b_0 + (f_1 − α f_0) b_1`:
 /// for T_0, T_2: `b_0 − T_2(x) b_1`; for T_1, T_3: `x (b_0 − b_1)`.
 pub fn chebyshev_t_sum(c: &[f64], x: f64) -> f64 {
@@ -403,7 +403,7 @@ pub fn chebyshev_t_sum(c: &[f64], x: f64) -> f64 {
     e0 - (2.0 * x * x - 1.0) * e1 + x * (o0 - o1)
 }
 
-/// Σ c_k U_k(x) by Clenshaw's recurrence in steps of two ([`clenshaw_pairs`]): for U_0, U_2
+/// Σ c_k U_k(x) by Clenshaw's recurrence in steps of two (`clenshaw_pairs`): for U_0, U_2
 /// the sum is `b_0 + b_1`, for U_1, U_3 it is `2x b_0` (see [`chebyshev_t_sum`]).
 pub fn chebyshev_u_sum(c: &[f64], x: f64) -> f64 {
     let ([e0, e1], [o0, _]) = clenshaw_pairs(c, x);

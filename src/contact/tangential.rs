@@ -31,7 +31,10 @@
 //! that map series coefficients to values at the other unknowns' points, `InnerMaps`) are
 //! built once per evaluation, so that a pass of the iteration is a handful of matrix–vector
 //! products (the collocation solves themselves are products with the precomputed
-//! transform-times-inverse matrices of [`crate::quadrature`]). When no attempt of a step
+//! transform-times-inverse matrices of [`crate::quadrature`]). The inner iteration starts from
+//! the previous iterate's coefficients and is solved only as far as the outer iteration needs:
+//! to 1e−3 of the residual being reduced (an inexact Newton method, `inner_tolerance`), and
+//! to 1e−14 for the residual that is accepted. When no attempt of a step
 //! converges, the best admissible iterate whose residual stalled below
 //! `SlipOptions::stall_tolerance` is accepted and keeps its residual in the step record.
 //! (Block Gauss–Seidel between the stick ends and (a, c), as in the seed paper, falls into
@@ -602,7 +605,11 @@ const INNER_TOLERANCE: f64 = 1e-14;
 /// 1e−3) of the residual being reduced; never looser than 1e−8 nor tighter than
 /// [`INNER_TOLERANCE`]. A step is accepted only on a residual evaluated at the full tolerance
 /// (measured, 0.30 → 0.35 ηP at M = 128: 71 → 51 passes of the inner iteration, the same
-/// number of residual evaluations).
+/// number of residual evaluations). The first step after a reversal, whose failed attempts
+/// wander, reacts to the inner tolerance erratically: against full inner solves it took
+/// 30 / 91 / 315 ms instead of 34 / 97 / 350 ms at M = 64 / 128 / 256, but 3.5 s instead of
+/// 1.4 s at M = 512 (an upper clamp of 1e−10: 111 / 273 / 368 ms and 1.27 s; loose solves
+/// within a phase only: 38 / 98 / 351 ms and 1.41 s, the default run 0.60 s instead of 0.54 s).
 fn inner_tolerance(residual: f64) -> f64 {
     (1e-3 * residual).clamp(INNER_TOLERANCE, 1e-8)
 }
