@@ -1511,8 +1511,15 @@ fn solve_geometry(
         state = sn;
         tight = full;
     }
-    // Every accepted iterate lowered the residual, so the last one is the best.
-    let size = norm(&r);
+    // Every accepted iterate lowered the residual, so the last one is the best. A stalled
+    // iterate that may be accepted is first solved at the full inner tolerance (its inner
+    // solve may have stopped at 1e−3 of the residual before it).
+    let mut size = norm(&r);
+    if size < options.stall_tolerance && !tight {
+        (r, state, _) = problem.evaluate(&g, &state, INNER_TOLERANCE)?;
+        evaluations += 1;
+        size = norm(&r);
+    }
     let stalled = (size < options.stall_tolerance)
         .then(|| accept(state, g.a, iterations, evaluations, size, jac).ok())
         .flatten()
