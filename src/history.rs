@@ -26,7 +26,8 @@
 //! # Warm start
 //! Inside a phase the geometry of the step (stick ends, contact half-width and centre) is
 //! extrapolated from the last three steps by the quadratic in Q through them (`predict`), and
-//! the previous step's Jacobian starts the quasi-Newton iteration. At the
+//! the previous step's Jacobian starts the quasi-Newton iteration (after a step with mixed
+//! slip signs the Mindlin–Deresiewicz guess below is tried first). At the
 //! start of a phase the zones that already slip in the new direction keep slipping and the
 //! others stick, with new slip zones of the Mindlin–Deresiewicz width
 //! `a(1 − √(1 − |ΔQ|/(2ηP)))` at the ends that start to slip.
@@ -623,7 +624,19 @@ pub fn solve_step(
     let md = (1.0
         - ((q - start_load).abs() / (2.0 * model.friction * driver.state.normal_load)).min(0.95))
     .sqrt();
-    let guesses = [guess, (c - a * md, c + a * md)];
+    let md_guess = (c - a * md, c + a * md);
+    // After a step with mixed slip signs (the first steps after a reversal, one edge still
+    // slipping the old way) the previous stick ends do not continue the standard state: its
+    // edge zone closes and that stick end jumps. The continuation then converges to a state
+    // that fails the stick check (default run: about 20 evaluations at each such step), so
+    // the Mindlin–Deresiewicz guess goes first (default run: 1439 → 1330 residual evaluations
+    // in all, the same states).
+    let after_mixed = driver.warm.is_some_and(|w| w.signs != (sign, sign));
+    let guesses = if after_mixed {
+        [md_guess, guess]
+    } else {
+        [guess, md_guess]
+    };
     let warm = driver.warm.map(|w| WarmStart {
         contact: predicted.map(|[.., a, c]| (a, c)),
         ..w
