@@ -30,7 +30,8 @@
 //! slip signs the Mindlin–Deresiewicz guess below is tried first). At the
 //! start of a phase the zones that already slip in the new direction keep slipping and the
 //! others stick, with new slip zones of the Mindlin–Deresiewicz width
-//! `a(1 − √(1 − |ΔQ|/(2ηP)))` at the ends that start to slip.
+//! `a(1 − √(1 − |ΔQ|/(2ηP)))` at the ends that start to slip, and the contact centre moves by
+//! ΔQ times dc/dQ of the previous phase's first step.
 
 use std::sync::Arc;
 
@@ -295,6 +296,9 @@ pub struct DriverState {
     approach: Option<f64>,
     /// Slip signs and Jacobian of the last step, the warm start of the next step of a phase.
     warm: Option<WarmStart>,
+    /// `dc/dQ` over the first step of the current phase: the start of the next phase's
+    /// prediction of the contact centre.
+    first_centre_slope: Option<f64>,
 }
 
 impl DriverState {
@@ -323,6 +327,7 @@ impl DriverState {
             anchor_ux: None,
             approach: None,
             warm: None,
+            first_centre_slope: None,
         }
     }
 }
@@ -637,10 +642,18 @@ pub fn solve_step(
     } else {
         [guess, md_guess]
     };
-    let warm = driver.warm.map(|w| WarmStart {
-        contact: predicted.map(|[.., a, c]| (a, c)),
-        ..w
-    });
+    // The contact's half-width and centre to start from: extrapolated within a phase. At a
+    // phase start the centre is moved by dc/dQ of the previous phase's first step times ΔQ,
+    // and the half-width, which changes little, is kept. (Default history: the first step of
+    // each reversal moves the centre by ∓2.6e−3 a, 1.25 times the first loading step's
+    // 2.1e−3 a; started from the old centre, the mixed-sign attempt of a reversal step spent
+    // about ten quasi-Newton iterations getting there. Default run: 1330 → 1168 residual
+    // evaluations in all, the same states.)
+    let contact = if new_phase {
+        driver.first_centre_slope.map(|slope| (a, c + slope * dq))
+    } else {
+        predicted.map(|[.., a, c]| (a, c))
+    };
     let solved: SlipStep = solve_slip(
         model,
         disc,
@@ -650,7 +663,12 @@ pub fn solve_step(
         q,
         sign,
         &guesses,
-        if new_phase { None } else { warm.as_ref() },
+        contact,
+        if new_phase {
+            None
+        } else {
+            driver.warm.as_ref()
+        },
         options,
     )
     .map_err(|failure| StepFailure {
@@ -661,6 +679,7 @@ pub fn solve_step(
         failure,
     })?;
     if new_phase {
+        driver.first_centre_slope = Some((solved.state.centre - c) / dq);
         driver.phase += 1;
         driver.phase_start_load = start_load;
         driver.phase_sign = Some(sign);
@@ -693,7 +712,6 @@ pub fn solve_step(
             solved.state.traction.right_sign,
         ),
         jacobian: solved.jacobian,
-        contact: None,
     });
     let old = std::mem::replace(&mut driver.state, solved.state.clone());
     let stick = driver

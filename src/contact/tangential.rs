@@ -1082,14 +1082,13 @@ pub struct WarmStart {
     pub signs: (f64, f64),
     /// Jacobian of the residuals with respect to `(lo, hi, a, c)`.
     pub jacobian: [[f64; 4]; 4],
-    /// Predicted contact half-width and centre `(a, c)` of the step, to start the iteration
-    /// from the first stick-end guess (otherwise the previous step's are used).
-    pub contact: Option<(f64, f64)>,
 }
 
 /// Solve one step at tangential load `tangential_load` with slip sign `sign`, starting from
 /// `start` (the previous step), stick-zone guesses tried in turn and the phase's inherited
-/// correction chain `base`.
+/// correction chain `base`. `contact`, when given, is the predicted contact half-width and
+/// centre `(a, c)` from which the attempts with the first stick-zone guess start (otherwise
+/// they start from `start`'s).
 #[allow(clippy::too_many_arguments)]
 pub fn solve_slip(
     model: &ContactModel,
@@ -1100,6 +1099,7 @@ pub fn solve_slip(
     tangential_load: f64,
     sign: f64,
     guesses_in: &[(f64, f64)],
+    contact: Option<(f64, f64)>,
     warm: Option<&WarmStart>,
     options: SlipOptions,
 ) -> Result<SlipStep, SolveFailure> {
@@ -1195,9 +1195,9 @@ pub fn solve_slip(
             } else {
                 Method::Broyden(warm.filter(|w| w.signs == signs).map(|w| w.jacobian))
             };
-            let contact = warm
-                .filter(|w| w.signs == signs && guess == guesses_in[0])
-                .and_then(|w| w.contact);
+            // Within a phase the prediction continues the warm start's slip signs only.
+            let contact =
+                contact.filter(|_| guess == guesses_in[0] && warm.is_none_or(|w| w.signs == signs));
             match solve_geometry(&problem, start, start, (guess, contact), method, options) {
                 Ok(step) => return Ok(step),
                 Err(failed) => attempts.record(failed),
