@@ -606,7 +606,9 @@ const INNER_TOLERANCE: f64 = 1e-14;
 /// [`INNER_TOLERANCE`]. A step is accepted only on a residual evaluated at the full tolerance
 /// (measured, 0.30 → 0.35 ηP at M = 128: 71 → 51 passes of the inner iteration, the same
 /// number of residual evaluations). The first step after a reversal, whose failed attempts
-/// wander, reacts to the inner tolerance erratically: against full inner solves it took
+/// wander, reacts to the inner tolerance erratically: measured before the contact centre was
+/// predicted at phase starts (which made that step 2–5 times cheaper, 717 ms at M = 512),
+/// against full inner solves it took
 /// 30 / 91 / 315 ms instead of 34 / 97 / 350 ms at M = 64 / 128 / 256, but 3.5 s instead of
 /// 1.4 s at M = 512 (an upper clamp of 1e−10: 111 / 273 / 368 ms and 1.27 s; loose solves
 /// within a phase only: 38 / 98 / 351 ms and 1.41 s, the default run 0.60 s instead of 0.54 s).
