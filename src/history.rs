@@ -953,6 +953,48 @@ pub fn run_history(
 mod tests {
     use super::*;
 
+    /// The predictor is the polynomial through the phase's last steps: exact for a quadratic
+    /// path from three steps, for a linear one from two, constant from one, and a repeated
+    /// load does not make it singular.
+    #[test]
+    fn predictor_is_exact_for_polynomial_paths() {
+        let path = |q: f64| {
+            [
+                q,
+                -1.0 + 0.1 * q - 0.02 * q * q,
+                0.5 - 0.3 * q,
+                2.0 + q * q,
+                -q,
+            ]
+        };
+        let close = |p: [f64; 4], q: f64| {
+            p.iter()
+                .zip(&path(q)[1..])
+                .all(|(a, b)| (a - b).abs() <= 1e-12 * b.abs().max(1.0))
+        };
+        assert!(predict(&[], 1.0).is_none());
+        let three = [path(1.0), path(2.0), path(3.0)];
+        assert!(close(predict(&three, 3.5).unwrap(), 3.5));
+        let line = |q: f64| [q, 1.0 + q, 2.0 - q, 3.0, 0.5 * q];
+        let two = [line(1.0), line(2.0)];
+        let p = predict(&two, 4.0).unwrap();
+        assert!(
+            p.iter()
+                .zip(&line(4.0)[1..])
+                .all(|(a, b)| (a - b).abs() < 1e-12)
+        );
+        assert!((predict(&[line(1.0)], 4.0).unwrap()[0] - 2.0).abs() < 1e-15);
+        // A repeated load: the duplicate is dropped and the rest is used.
+        let repeated = [line(1.0), line(2.0), line(2.0)];
+        let p = predict(&repeated, 4.0).unwrap();
+        assert!(p.iter().all(|v| v.is_finite()));
+        assert!(
+            p.iter()
+                .zip(&line(4.0)[1..])
+                .all(|(a, b)| (a - b).abs() < 1e-12)
+        );
+    }
+
     #[test]
     fn transition_table() {
         let tol = 1e-9;
