@@ -377,6 +377,21 @@ pub struct UnboundedSeries {
     pub gamma: Vec<f64>,
 }
 
+/// One evaluation row, `row[n] = scale · v_n(τ)` with `v_{n+1} = 2τ v_n − v_{n−1}` from
+/// `(v_{−1}, v_0, scale)`: the single-point form of [`RowMatrix::fill_recurrence_rows`] (the
+/// same operations in the same order); a zero scale gives a zero row.
+fn recurrence_row(tau: f64, [mut prev, mut cur, scale]: [f64; 3], row: &mut [f64]) {
+    if scale.abs() <= 0.0 {
+        row.fill(0.0);
+        return;
+    }
+    let two_tau = 2.0 * tau;
+    for r in row.iter_mut() {
+        *r = scale * cur;
+        (prev, cur) = (cur, two_tau * cur - prev);
+    }
+}
+
 /// Clenshaw's recurrence in steps of two: the even- and odd-indexed terms of a Chebyshev sum
 /// (T or U) each obey `f_{j+1} = α f_j − f_{j−1}` with `α = 4x² − 2 = 2T_2(x)`, so the two
 /// sums run as independent chains `b_j = c + α b_{j+1} − b_{j+2}`, which the processor
@@ -461,26 +476,13 @@ impl BoundedSeries {
 
     /// The row r with `density(τ) = r · β`: `√(1−τ²) U_{n−1}(τ)`, n = 1..M (zero outside).
     pub fn density_row(tau: f64, row: &mut [f64]) {
-        if tau.abs() >= 1.0 {
-            row.fill(0.0);
-            return;
-        }
-        let s = (1.0 - tau * tau).sqrt();
-        let (mut u0, mut u1) = (0.0, 1.0);
-        for r in row.iter_mut() {
-            *r = s * u1;
-            (u0, u1) = (u1, 2.0 * tau * u1 - u0);
-        }
+        recurrence_row(tau, Self::density_start(tau), row);
     }
 
     /// The row r with `cauchy(τ) = r · β`: `−T_n(τ)` inside, `−zⁿ` outside, n = 1..M.
     pub fn cauchy_row(tau: f64, row: &mut [f64]) {
         if tau.abs() < 1.0 {
-            let (mut t0, mut t1) = (1.0, tau);
-            for r in row.iter_mut() {
-                *r = -t1;
-                (t0, t1) = (t1, 2.0 * tau * t1 - t0);
-            }
+            recurrence_row(tau, Self::cauchy_start_inside(tau), row);
         } else {
             let z = exterior(tau);
             let mut power = z;
@@ -543,16 +545,7 @@ impl UnboundedSeries {
 
     /// The row r with `density(τ) = r · γ`: `T_n(τ)/√(1−τ²)`, n = 0..M−1 (zero outside).
     pub fn density_row(tau: f64, row: &mut [f64]) {
-        if tau.abs() >= 1.0 {
-            row.fill(0.0);
-            return;
-        }
-        let s = 1.0 / (1.0 - tau * tau).sqrt();
-        let (mut t0, mut t1) = (1.0, tau);
-        for r in row.iter_mut() {
-            *r = s * t0;
-            (t0, t1) = (t1, 2.0 * tau * t1 - t0);
-        }
+        recurrence_row(tau, Self::density_start(tau), row);
     }
 
     /// `∫ density = π γ_0`.

@@ -124,6 +124,7 @@
 //! receding end, with the frictional work there below 1e−2 of the largest).
 
 use std::cell::RefCell;
+use std::collections::VecDeque;
 use std::sync::Arc;
 
 use serde::Serialize;
@@ -462,6 +463,8 @@ impl StepProblem<'_> {
         let mut crhs = vec![0.0; m.saturating_sub(1)];
         let mut work = vec![0.0; m + 1];
         let mut p_nodes = vec![0.0; maps.shape_nodes.rows()];
+        // The kink terms' roots and amplitudes of p and w, refilled in each pass.
+        let (mut roots, mut amp, mut w_amp) = (Vec::new(), Vec::new(), Vec::new());
         let scale = 1.0 / (model.radius * ystar);
         let p_scale = g.a * scale;
         let (mut lambda_p, mut lambda_q) = (0.0, 0.0);
@@ -475,16 +478,17 @@ impl StepProblem<'_> {
             } else {
                 [0.0; 2]
             };
-            let roots = kinks.roots(ends);
-            let amp = kinks.pressure_amplitudes(&roots);
-            let mut w_amp = vec![0.0; amp.len()];
+            kinks.roots_into(ends, &mut roots);
+            kinks.pressure_amplitudes_into(&roots, &mut amp);
+            w_amp.clear();
+            w_amp.resize(amp.len(), 0.0);
             for ((r, &xp), q) in rhs.iter_mut().zip(&pressure_points).zip(&x[..np]) {
                 *r = -xp * scale - kappa / ystar * q;
             }
             kinks.cauchy_at_pressure.add_apply(&amp, -1.0, &mut rhs);
             lambda_p = disc.bounded.solve_coefficients(&rhs, &mut beta_p);
             state.pressure.beta.clone_from(&beta_p);
-            state.pressure_kinks = kinks.kinks(&amp);
+            kinks.kinks_into(&amp, &mut state.pressure_kinks);
             // Charge (seed eqs. 53, 55, 41–42) for the current shear traction. The arcsine
             // moment of q fixes Γ under potential control; under charge control it only gives
             // φ0 and is evaluated once for the accepted state.
@@ -502,8 +506,8 @@ impl StepProblem<'_> {
                 state.charge = charge;
                 state.potential = potential;
                 let free = charge - model.pressure_charge(self.normal_load);
-                w_amp = kinks.charge_amplitudes(&roots);
-                state.charge_kinks = kinks.kinks(&w_amp);
+                kinks.charge_amplitudes_into(&roots, &mut w_amp);
+                kinks.kinks_into(&w_amp, &mut state.charge_kinks);
                 for (r, q) in crhs.iter_mut().zip(&x[np..np + nc]) {
                     *r = -e.w13 / e.y33 * q;
                 }
@@ -746,42 +750,42 @@ impl KinkMaps {
         }
     }
 
-    /// The root coefficients of all terms for the new stick ends' `ends`.
-    fn roots(&self, ends: [f64; 2]) -> Vec<f64> {
-        if self.points.is_empty() {
-            return Vec::new();
+    /// The root coefficients of all terms for the new stick ends' `ends`, into `out`.
+    fn roots_into(&self, ends: [f64; 2], out: &mut Vec<f64>) {
+        out.clear();
+        if !self.points.is_empty() {
+            out.extend(ends.iter().chain(&self.fixed_roots));
         }
-        ends.iter().chain(&self.fixed_roots).copied().collect()
     }
 
-    /// The amplitudes of p's kinks: p's root on the slip side of each point is
+    /// The amplitudes of p's kinks, into `out`: p's root on the slip side of each point is
     /// `A = side (κ/Y*) k/(1 + α²)`.
-    fn pressure_amplitudes(&self, roots: &[f64]) -> Vec<f64> {
-        roots
-            .iter()
-            .zip(&self.pressure_factor)
-            .zip(&self.to_amplitude)
-            .map(|((k, f), t)| f * k * t)
-            .collect()
+    fn pressure_amplitudes_into(&self, roots: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(
+            roots
+                .iter()
+                .zip(&self.pressure_factor)
+                .zip(&self.to_amplitude)
+                .map(|((k, f), t)| f * k * t),
+        );
     }
 
-    /// The amplitudes of w's kinks, `B = side (w13/y33)(k − side (κ/Y*) η² S² A)` with p's
-    /// root A (q = ηSp + q̃ carries p's stick-side root −side α A next to q̃'s).
-    fn charge_amplitudes(&self, roots: &[f64]) -> Vec<f64> {
-        roots
-            .iter()
-            .enumerate()
-            .map(|(j, k)| {
-                let side = self.points[j].1;
-                let root_p = self.pressure_factor[j] * k;
-                side * self.charge * (k - side * self.stick_side[j] * root_p) * self.to_amplitude[j]
-            })
-            .collect()
+    /// The amplitudes of w's kinks, into `out`: `B = side (w13/y33)(k − side (κ/Y*) η² S² A)`
+    /// with p's root A (q = ηSp + q̃ carries p's stick-side root −side α A next to q̃'s).
+    fn charge_amplitudes_into(&self, roots: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(roots.iter().enumerate().map(|(j, k)| {
+            let side = self.points[j].1;
+            let root_p = self.pressure_factor[j] * k;
+            side * self.charge * (k - side * self.stick_side[j] * root_p) * self.to_amplitude[j]
+        }));
     }
 
-    /// The kink terms with amplitudes `amp`.
-    fn kinks(&self, amp: &[f64]) -> Kinks {
-        Kinks(
+    /// The kink terms with amplitudes `amp`, into `out` (its allocation kept).
+    fn kinks_into(&self, amp: &[f64], out: &mut Kinks) {
+        out.0.clear();
+        out.0.extend(
             self.points
                 .iter()
                 .zip(amp)
@@ -790,9 +794,8 @@ impl KinkMaps {
                     at,
                     side,
                     amplitude,
-                })
-                .collect(),
-        )
+                }),
+        );
     }
 }
 
@@ -975,37 +978,56 @@ impl InnerMaps {
 /// plain iteration contracts only by the coupling factor per step.
 struct Anderson {
     depth: usize,
+    /// Whether `last_res` and `last_f` hold a previous pass.
+    started: bool,
     /// Previous residual `F(x) − x` and `F(x)`.
-    last: Option<(Vec<f64>, Vec<f64>)>,
-    /// Differences of residuals and of F values, newest last.
-    d_res: Vec<Vec<f64>>,
-    d_f: Vec<Vec<f64>>,
+    last_res: Vec<f64>,
+    last_f: Vec<f64>,
+    /// Differences of residuals and of F values, newest last; the oldest pair's buffers are
+    /// reused for the newest once `depth` are held.
+    d_res: VecDeque<Vec<f64>>,
+    d_f: VecDeque<Vec<f64>>,
+    /// This pass's residual.
+    res: Vec<f64>,
 }
 
 impl Anderson {
     fn new(depth: usize) -> Self {
         Self {
             depth,
-            last: None,
-            d_res: Vec::new(),
-            d_f: Vec::new(),
+            started: false,
+            last_res: Vec::new(),
+            last_f: Vec::new(),
+            d_res: VecDeque::with_capacity(depth + 1),
+            d_f: VecDeque::with_capacity(depth + 1),
+            res: Vec::new(),
         }
     }
 
     /// Replace `x` by the next iterate given `fx = F(x)`.
     fn next(&mut self, x: &mut [f64], fx: &[f64]) {
-        let res: Vec<f64> = fx.iter().zip(x.iter()).map(|(f, v)| f - v).collect();
-        if let Some((r_old, f_old)) = self.last.take() {
-            self.d_res
-                .push(res.iter().zip(&r_old).map(|(a, b)| a - b).collect());
-            self.d_f
-                .push(fx.iter().zip(&f_old).map(|(a, b)| a - b).collect());
-            if self.d_res.len() > self.depth {
-                self.d_res.remove(0);
-                self.d_f.remove(0);
-            }
+        self.res.clear();
+        self.res.extend(fx.iter().zip(x.iter()).map(|(f, v)| f - v));
+        if self.started {
+            let (mut dr, mut df) = if self.d_res.len() >= self.depth {
+                (
+                    self.d_res.pop_front().unwrap_or_default(),
+                    self.d_f.pop_front().unwrap_or_default(),
+                )
+            } else {
+                (Vec::new(), Vec::new())
+            };
+            dr.clear();
+            dr.extend(self.res.iter().zip(&self.last_res).map(|(a, b)| a - b));
+            df.clear();
+            df.extend(fx.iter().zip(&self.last_f).map(|(a, b)| a - b));
+            self.d_res.push_back(dr);
+            self.d_f.push_back(df);
         }
-        self.last = Some((res.clone(), fx.to_vec()));
+        self.started = true;
+        self.last_res.clone_from(&self.res);
+        self.last_f.clear();
+        self.last_f.extend_from_slice(fx);
         x.copy_from_slice(fx);
         let k = self.d_res.len();
         if k == 0 {
@@ -1018,7 +1040,7 @@ impl Anderson {
             .iter()
             .map(|di| {
                 let mut row: Vec<f64> = self.d_res.iter().map(|dj| dot(di, dj)).collect();
-                row.push(dot(di, &res));
+                row.push(dot(di, &self.res));
                 row
             })
             .collect();
@@ -1386,7 +1408,10 @@ fn solve_geometry(
         g.lo = c0 - 0.5 * a0;
         g.hi = c0 + 0.5 * a0;
     }
-    let (mut r, mut state, mut tight) = problem.evaluate(&g, from, INNER_TOLERANCE)?;
+    // A residual from a loose inner solve is solved again at the full inner tolerance
+    // before its iterate can be accepted.
+    let solve_fully = |g: &Geometry, s: &ContactState| problem.evaluate(g, s, INNER_TOLERANCE);
+    let (mut r, mut state, mut tight) = solve_fully(&g, from)?;
     let mut evaluations = 1;
     let mut jac = hint;
     let mut fresh = false;
@@ -1435,7 +1460,7 @@ fn solve_geometry(
         if size < options.tolerance && !tight {
             // Converged on a loose inner solve: confirm at the full inner tolerance (from the
             // loose solution, a pass or two).
-            (r, state, tight) = problem.evaluate(&g, &state, INNER_TOLERANCE)?;
+            (r, state, tight) = solve_fully(&g, &state)?;
             evaluations += 1;
             continue;
         }
@@ -1518,7 +1543,7 @@ fn solve_geometry(
     // solve may have stopped at 1e−3 of the residual before it).
     let mut size = norm(&r);
     if size < options.stall_tolerance && !tight {
-        (r, state, _) = problem.evaluate(&g, &state, INNER_TOLERANCE)?;
+        (r, state, _) = solve_fully(&g, &state)?;
         evaluations += 1;
         size = norm(&r);
     }
