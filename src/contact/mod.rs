@@ -329,6 +329,29 @@ struct FadeTable {
     not_zero: Vec<(f64, f64, f64)>,
 }
 
+impl FadeTable {
+    /// The nodes whose terms can be non-zero at a point where χ is `cx`.
+    fn nodes_for(&self, cx: f64) -> &[(f64, f64, f64)] {
+        // χ is exactly 1 (or 0) away from the ramps; only exact zeros are skipped.
+        if (cx - 1.0).abs() <= 0.0 {
+            &self.not_one
+        } else if cx.abs() <= 0.0 {
+            &self.not_zero
+        } else {
+            &self.all
+        }
+    }
+}
+
+/// `Σ w q̃_E(t) (χ(t) − χ(x))/(t − x)` over `nodes`, skipping a node within `tiny` of x.
+fn fade_sum(nodes: &[(f64, f64, f64)], x: f64, cx: f64, tiny: f64) -> f64 {
+    nodes
+        .iter()
+        .filter(|(t, _, _)| (t - x).abs() > tiny)
+        .map(|(t, wq, chi)| wq * (chi - cx) / (t - x))
+        .sum()
+}
+
 impl PartialEq for Inherited {
     fn eq(&self, other: &Self) -> bool {
         self.zone == other.zone && self.ramp_lo == other.ramp_lo && self.ramp_hi == other.ramp_hi
@@ -365,14 +388,23 @@ impl Inherited {
     fn table(&self) -> &FadeTable {
         self.table.get_or_init(|| {
             let (nodes, weights) = graded_rule();
-            let mut all = Vec::new();
+            let mut points = Vec::new();
+            let mut scaled_weights = Vec::new();
             for w in self.pieces().windows(2) {
                 let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
                 for (u, wt) in nodes.iter().zip(weights) {
-                    let t = mid + half * u;
-                    all.push((t, wt * half * self.zone.correction_at(t), self.chi(t)));
+                    points.push(mid + half * u);
+                    scaled_weights.push(wt * half);
                 }
             }
+            let mut values = Vec::with_capacity(points.len());
+            self.zone.corrections_into(&points, &mut values);
+            let all: Vec<(f64, f64, f64)> = points
+                .iter()
+                .zip(&scaled_weights)
+                .zip(&values)
+                .map(|((&t, &w), &q)| (t, w * q, self.chi(t)))
+                .collect();
             let except = |v: f64| {
                 all.iter()
                     .copied()
@@ -421,6 +453,18 @@ impl Inherited {
             }
         } else {
             self.zone.correction_at(x)
+        }
+    }
+
+    /// [`Self::value`] at each of `xs` into `out` (bit-identical, the zone's values in a batch,
+    /// [`StickZone::corrections_into`]).
+    pub fn values_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        self.zone.corrections_into(xs, out);
+        if self.faded() {
+            for (o, &x) in out.iter_mut().zip(xs) {
+                let chi = self.chi(x);
+                *o = if chi.abs() > 0.0 { chi * *o } else { 0.0 };
+            }
         }
     }
 
@@ -485,27 +529,63 @@ impl Inherited {
             return self.zone.correction_cauchy(x);
         }
         let cx = self.chi(x);
-        let tiny = 1e-14 * (self.zone.hi - self.zone.lo);
-        let table = self.table();
-        // χ is exactly 1 (or 0) away from the ramps; only exact zeros are skipped.
-        let nodes = if (cx - 1.0).abs() <= 0.0 {
-            &table.not_one
-        } else if cx.abs() <= 0.0 {
-            &table.not_zero
-        } else {
-            &table.all
-        };
-        let sum: f64 = nodes
-            .iter()
-            .filter(|(t, _, _)| (t - x).abs() > tiny)
-            .map(|(t, wq, chi)| wq * (chi - cx) / (t - x))
-            .sum();
+        let sum = fade_sum(self.table().nodes_for(cx), x, cx, self.fade_tiny());
+        self.with_own_cauchy(x, cx, sum)
+    }
+
+    /// Nodes closer than this to a point are left out of its fade sum.
+    fn fade_tiny(&self) -> f64 {
+        1e-14 * (self.zone.hi - self.zone.lo)
+    }
+
+    /// `χ(x) H'q̃_E(x) + sum/π`, the first term only where χ ≠ 0.
+    fn with_own_cauchy(&self, x: f64, cx: f64, sum: f64) -> f64 {
         let own = if cx.abs() > 0.0 {
             cx * self.zone.correction_cauchy(x)
         } else {
             0.0
         };
         own + sum / std::f64::consts::PI
+    }
+
+    /// [`Self::cauchy`] at each of `xs` into `out` (bit-identical: four points whose χ picks
+    /// the same node list share one pass over it, each point's terms summed in the same order;
+    /// a skipped node adds −0, which leaves any sum unchanged).
+    pub fn cauchy_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        if !self.faded() {
+            out.extend(xs.iter().map(|&x| self.zone.correction_cauchy(x)));
+            return;
+        }
+        let (tiny, table) = (self.fade_tiny(), self.table());
+        let mut k = 0;
+        while k < xs.len() {
+            let x: [f64; 4] = std::array::from_fn(|l| xs.get(k + l).copied().unwrap_or(f64::NAN));
+            let cx = x.map(|x| self.chi(x));
+            let nodes = table.nodes_for(cx[0]);
+            let shared = (k + 4 <= xs.len())
+                && cx[1..]
+                    .iter()
+                    .all(|&c| std::ptr::eq(table.nodes_for(c), nodes));
+            if shared {
+                let mut sums = [-0.0f64; 4];
+                for &(t, wq, chi) in nodes {
+                    for l in 0..4 {
+                        let d = t - x[l];
+                        let term = wq * (chi - cx[l]) / d;
+                        sums[l] += if d.abs() > tiny { term } else { -0.0 };
+                    }
+                }
+                for l in 0..4 {
+                    out.push(self.with_own_cauchy(x[l], cx[l], sums[l]));
+                }
+                k += 4;
+            } else {
+                let sum = fade_sum(nodes, x[0], cx[0], tiny);
+                out.push(self.with_own_cauchy(x[0], cx[0], sum));
+                k += 1;
+            }
+        }
     }
 
     /// `∫ χ q̃_E dx`.
@@ -634,6 +714,55 @@ impl StickZone {
             + self.extras_with(|u, v| half_ellipse(x, u, v))
     }
 
+    /// [`Self::correction_at`] at each of `xs` into `out` (bit-identical; the own series is
+    /// summed four points at a time, [`BoundedSeries::density4`], and the chain in batches).
+    pub fn corrections_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        let (mid, half) = (self.mid(), self.half());
+        let mut chunks = xs.chunks_exact(4);
+        for chunk in chunks.by_ref() {
+            let u: [f64; 4] = std::array::from_fn(|l| (chunk[l] - mid) / half);
+            let series = if self.correction.beta.is_empty() {
+                None
+            } else {
+                Some(self.correction.density4(u))
+            };
+            for l in 0..4 {
+                out.push(self.own_with(u[l], series.map(|s| s[l]), kink_density));
+            }
+        }
+        for &x in chunks.remainder() {
+            out.push(self.own_part(x, BoundedSeries::density, kink_density));
+        }
+        if let Some(link) = &self.inherited {
+            let mut inner = Vec::with_capacity(xs.len());
+            link.values_into(xs, &mut inner);
+            for (o, v) in out.iter_mut().zip(inner) {
+                *o += v;
+            }
+        }
+        for (o, &x) in out.iter_mut().zip(xs) {
+            *o = if x > self.lo && x < self.hi {
+                *o + self.extras_with(|u, v| half_ellipse(x, u, v))
+            } else {
+                0.0
+            };
+        }
+    }
+
+    /// [`Self::own_part`] at u from the series' term there (`None` when the zone has no
+    /// series) and the kink term through `kink`.
+    fn own_with(&self, u: f64, series: Option<f64>, kink: fn(f64) -> f64) -> f64 {
+        let mut own = 0.0;
+        if let Some(s) = series {
+            own += s;
+        }
+        if self.kink.abs() > 0.0 {
+            own += self.kink * kink(u);
+        }
+        own
+    }
+
     /// `Σ amplitude · f(u, v)` over the closed-form extras.
     fn extras_with(&self, f: impl Fn(f64, f64) -> f64) -> f64 {
         self.extras.iter().map(|&(u, v, amp)| amp * f(u, v)).sum()
@@ -646,6 +775,33 @@ impl StickZone {
             .get()
             .and_then(|t| t.at(x))
             .unwrap_or_else(|| self.direct_cauchy(x))
+    }
+
+    /// [`Self::correction_cauchy`] at each of `xs` into `out` (bit-identical; the chain's fade
+    /// integrals in batches, [`Inherited::cauchy_into`]).
+    pub fn correction_cauchys_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        if let Some(table) = self.cauchy_table.0.get() {
+            out.extend(
+                xs.iter()
+                    .map(|&x| table.at(x).unwrap_or_else(|| self.direct_cauchy(x))),
+            );
+            return;
+        }
+        out.extend(
+            xs.iter()
+                .map(|&x| self.own_part(x, BoundedSeries::cauchy, kink_cauchy)),
+        );
+        if let Some(link) = &self.inherited {
+            let mut inner = Vec::with_capacity(xs.len());
+            link.cauchy_into(xs, &mut inner);
+            for (o, v) in out.iter_mut().zip(inner) {
+                *o += v;
+            }
+        }
+        for (o, &x) in out.iter_mut().zip(xs) {
+            *o += self.extras_with(|u, v| half_ellipse_cauchy(x, u, v));
+        }
     }
 
     /// `H'q̃(x)` from the series and the chain.
@@ -664,14 +820,8 @@ impl StickZone {
         kink: fn(f64) -> f64,
     ) -> f64 {
         let u = (x - self.mid()) / self.half();
-        let mut own = 0.0;
-        if !self.correction.beta.is_empty() {
-            own += series(&self.correction, u);
-        }
-        if self.kink.abs() > 0.0 {
-            own += self.kink * kink(u);
-        }
-        own
+        let series = (!self.correction.beta.is_empty()).then(|| series(&self.correction, u));
+        self.own_with(u, series, kink)
     }
 
     /// Whether the zone carries nothing of its own: q̃ is exactly its inherited link's.
@@ -1061,6 +1211,29 @@ impl ContactState {
             - w13 * self.potential_charge_at(x)
             + model.compliance.y11 * self.traction_cauchy(x)
     }
+
+    /// [`Self::strain_at`] at each of `xs` into `out` (bit-identical; `H'q̃` of the stick
+    /// zone's chain in a batch, [`StickZone::correction_cauchys_into`]).
+    pub fn strains_into(&self, model: &ContactModel, xs: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        let mut chain = Vec::new();
+        if let Some(stick) = &self.traction.stick {
+            stick.correction_cauchys_into(xs, &mut chain);
+        }
+        let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
+        let local = model.local_pressure_strain(self.split);
+        for (k, &x) in xs.iter().enumerate() {
+            // `traction_cauchy` with the chain's part from the batch.
+            let traction_cauchy = match &self.traction.stick {
+                None => 0.0,
+                Some(_) => self.traction.friction * self.shape_cauchy(x) + chain[k],
+            };
+            out.push(
+                -local * self.pressure_at(x) - w13 * self.potential_charge_at(x)
+                    + model.compliance.y11 * traction_cauchy,
+            );
+        }
+    }
 }
 
 /// Where the strain change between two states is not smooth: both states' traction
@@ -1150,6 +1323,16 @@ pub fn graded_integral(points: Vec<f64>, nodes: usize, f: &dyn Fn(f64) -> f64) -
 /// ([`crate::quadrature::gauss_legendre_cumulative`]). Nested integrals such as
 /// `∫ g(t) ∫_t^R f ds dt` then cost one evaluation of f per node.
 pub fn graded_cumulative(points: Vec<f64>, nodes: usize, f: &dyn Fn(f64) -> f64) -> GradedTable {
+    graded_rule_with(nodes).cumulative(points, &|xs, out| out.extend(xs.iter().map(|&x| f(x))))
+}
+
+/// [`graded_cumulative`] with f evaluated a piece's nodes at a time: `f(xs, out)` pushes the
+/// values at `xs` onto `out` (passed empty).
+pub fn graded_cumulative_batch(
+    points: Vec<f64>,
+    nodes: usize,
+    f: &dyn Fn(&[f64], &mut Vec<f64>),
+) -> GradedTable {
     graded_rule_with(nodes).cumulative(points, f)
 }
 
@@ -1217,14 +1400,18 @@ impl GradedRule {
             .sum()
     }
 
-    fn cumulative(&self, points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> GradedTable {
+    fn cumulative(&self, points: Vec<f64>, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> GradedTable {
         let (nodes, weights) = (&self.nodes, &self.weights);
         let n = nodes.len();
         let points = piece_ends(points);
         let mut table = GradedTable::default();
+        let (mut at, mut values) = (Vec::with_capacity(n), Vec::with_capacity(n));
         for w in points.windows(2) {
             let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-            let values: Vec<f64> = nodes.iter().map(|u| f(mid + half * u)).collect();
+            at.clear();
+            at.extend(nodes.iter().map(|u| mid + half * u));
+            values.clear();
+            f(&at, &mut values);
             for k in 0..n {
                 let row = &self.cumulative[k * n..(k + 1) * n];
                 let before: f64 = half * row.iter().zip(&values).map(|(c, v)| c * v).sum::<f64>();

@@ -332,15 +332,18 @@ impl StepProblem<'_> {
         };
         // Parts of the stick right-hand side that do not change in the inner iteration (with
         // no charge unknown, whatever charge the state carries is among them).
+        let mut chain_cauchy = Vec::with_capacity(m);
+        closed.correction_cauchys_into(&stick_points, &mut chain_cauchy);
         let fixed: Vec<f64> = stick_points
             .iter()
-            .map(|&x| {
+            .zip(&chain_cauchy)
+            .map(|(&x, h)| {
                 let fixed_charge = if split.conducting {
                     0.0
                 } else {
                     w13 * guess.potential_charge_at(x) / y11
                 };
-                self.memory.strain(model, x) / y11 - closed.correction_cauchy(x) + fixed_charge
+                self.memory.strain(model, x) / y11 - h + fixed_charge
             })
             .collect();
         let inherited_force = closed.correction_integral();
@@ -357,12 +360,12 @@ impl StepProblem<'_> {
         // The traction at the pressure and charge points is `η p S + q̃_own + q̃_inherited`;
         // S and the inherited part depend on the geometry only, so they are evaluated once.
         let sampled = |points: &[f64]| -> Vec<(f64, f64)> {
+            let mut inherited = Vec::with_capacity(points.len());
+            closed.corrections_into(points, &mut inherited);
             points
                 .iter()
-                .map(|&x| {
-                    let inh = closed.correction_at(x);
-                    (state.slip_shape(x), inh)
-                })
+                .zip(inherited)
+                .map(|(&x, inh)| (state.slip_shape(x), inh))
                 .collect()
         };
         let fixed_p = sampled(&pressure_points);
@@ -1633,7 +1636,14 @@ pub fn assess_step(
     // `slip_zone_rule_nodes` per balanced piece give the slips to 1.2e−6 of the largest
     // (measured over the default history at M = 64 … 512 against four times the nodes), far
     // inside the check's tolerance of 1e−2.
-    let d_strain = |s: f64| new.strain_at(model, s) - old.strain_at(model, s);
+    let d_strain = |xs: &[f64], out: &mut Vec<f64>| {
+        let mut before = Vec::with_capacity(xs.len());
+        new.strains_into(model, xs, out);
+        old.strains_into(model, xs, &mut before);
+        for (n, o) in out.iter_mut().zip(before) {
+            *n -= o;
+        }
+    };
     let breaks = super::step_breakpoints(old, new);
     let mut slips = Vec::new();
     let zones = [
@@ -1662,7 +1672,7 @@ pub fn assess_step(
         pts.extend(&samples);
         pts.extend([left, right]);
         let nodes = super::slip_zone_rule_nodes(new.pressure.beta.len()) / 2;
-        let table = super::graded_cumulative(pts, nodes, &d_strain);
+        let table = super::graded_cumulative_batch(pts, nodes, &d_strain);
         for x in samples {
             // ∫ from `left` to x: the nodes of the pieces before x (x is a piece end).
             let before: f64 = table

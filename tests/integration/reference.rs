@@ -1379,3 +1379,96 @@ fn surface_displacement_quadrature_scales_with_m() {
     eprintln!("ux = {got:e}, reference {reference:e}, change over the ramp {change:e}: {error:e}");
     assert!(error < 1e-10, "{error:e}");
 }
+
+/// The batched evaluations that the step solver and its checks use (`strains_into`,
+/// `corrections_into`, `correction_cauchys_into`) give bit for bit the values of the
+/// one-point functions, on the states of a history through a reversal: first-loading states
+/// (the normal-loading zone faded at both ends), mixed-sign states after the reversal, and
+/// zones that inherit a turning state whole; at points inside and outside the contact, at the
+/// stick ends and the fade ramps' ends, in counts that are not multiples of four.
+#[test]
+fn batched_fields_equal_the_one_point_fields() {
+    use fretsim::contact::ContactState;
+    use fretsim::contact::tangential::SlipOptions;
+    use fretsim::history::{LoadHistory, Observer, StepRecord, run_history};
+    struct States(Vec<ContactState>);
+    impl Observer for States {
+        fn on_step(&mut self, _: &StepRecord, state: &ContactState) {
+            self.0.push(state.clone());
+        }
+    }
+    let b = baseline(32);
+    let history = LoadHistory {
+        points: vec![(0.0, 0.0), (1.0, 0.5 * b.lim), (2.0, 0.2 * b.lim)],
+        steps_per_segment: 6,
+        max_step: 0.1 * b.lim,
+    };
+    let mut states = States(Vec::new());
+    run_history(
+        &b.model,
+        &b.disc,
+        &b.normal,
+        &history,
+        SlipOptions::default(),
+        &mut states,
+    )
+    .unwrap();
+    let (mut mixed, mut faded, mut whole) = (0, 0, 0);
+    for s in &states.0 {
+        let Some(zone) = s.traction.stick.as_ref() else {
+            continue;
+        };
+        mixed += usize::from(s.traction.left_sign != s.traction.right_sign);
+        for link in zone.links() {
+            if link.ramp_lo.is_some() || link.ramp_hi.is_some() {
+                faded += 1;
+            } else {
+                whole += 1;
+            }
+        }
+        let (c, a) = (s.centre, s.half_width);
+        let mut xs: Vec<f64> = (0..=201)
+            .map(|i| c - 1.1 * a + 2.2 * a * i as f64 / 201.0)
+            .collect();
+        xs.extend([zone.lo, zone.hi, c - a, c + a]);
+        for link in zone.links() {
+            xs.extend(
+                [link.ramp_lo, link.ramp_hi]
+                    .into_iter()
+                    .flatten()
+                    .flat_map(|r| [r.0, r.1]),
+            );
+        }
+        // Runs of points with χ = 1, χ = 0 and 0 < χ < 1 interleaved.
+        xs.extend([zone.lo, c, zone.hi, c, zone.lo, zone.lo + 1e-3 * a, c]);
+        let (mut strains, mut values, mut transforms) = (Vec::new(), Vec::new(), Vec::new());
+        s.strains_into(&b.model, &xs, &mut strains);
+        zone.corrections_into(&xs, &mut values);
+        zone.correction_cauchys_into(&xs, &mut transforms);
+        for (k, &x) in xs.iter().enumerate() {
+            assert_eq!(
+                strains[k].to_bits(),
+                s.strain_at(&b.model, x).to_bits(),
+                "strain at {x}"
+            );
+            assert_eq!(
+                values[k].to_bits(),
+                zone.correction_at(x).to_bits(),
+                "q̃ at {x}"
+            );
+            assert_eq!(
+                transforms[k].to_bits(),
+                zone.correction_cauchy(x).to_bits(),
+                "H'q̃ at {x}"
+            );
+        }
+    }
+    eprintln!(
+        "{} states: {mixed} mixed, {faded} faded links, {whole} whole",
+        states.0.len()
+    );
+    assert!(
+        mixed > 0 && faded > 0 && whole > 0,
+        "{mixed} mixed, {faded} faded, {whole} whole"
+    );
+}
