@@ -444,6 +444,15 @@ pub fn chebyshev_u_sum(c: &[f64], x: f64) -> f64 {
     e0 + e1 + 2.0 * x * o0
 }
 
+/// [`chebyshev_t_sum`] at four points (bit-identical, [`clenshaw_pairs4`]).
+pub fn chebyshev_t_sum4(c: &[f64], x: [f64; 4]) -> [f64; 4] {
+    let chains = clenshaw_pairs4(c, x);
+    std::array::from_fn(|l| {
+        let ([e0, e1], [o0, o1]) = chains[l];
+        e0 - (2.0 * x[l] * x[l] - 1.0) * e1 + x[l] * (o0 - o1)
+    })
+}
+
 /// [`chebyshev_u_sum`] at four points (bit-identical, [`clenshaw_pairs4`]).
 pub fn chebyshev_u_sum4(c: &[f64], x: [f64; 4]) -> [f64; 4] {
     let chains = clenshaw_pairs4(c, x);
@@ -549,6 +558,27 @@ impl BoundedSeries {
             -z * power_sum(&self.beta, z)
         }
     }
+
+    /// [`Self::cauchy`] at four points (bit-identical: inside, the four recurrences run
+    /// interleaved with the operations of the one-point form; a point outside is evaluated
+    /// alone).
+    pub fn cauchy4(&self, tau: [f64; 4]) -> [f64; 4] {
+        let (mut b1, mut b2) = ([0.0; 4], [0.0; 4]);
+        for &bn in self.beta.iter().rev() {
+            for l in 0..4 {
+                let b0 = 2.0 * tau[l] * b1[l] - b2[l] - bn;
+                b2[l] = b1[l];
+                b1[l] = b0;
+            }
+        }
+        std::array::from_fn(|l| {
+            if tau[l].abs() < 1.0 {
+                tau[l] * b1[l] - b2[l]
+            } else {
+                self.cauchy(tau[l])
+            }
+        })
+    }
 }
 
 impl UnboundedSeries {
@@ -571,6 +601,18 @@ impl UnboundedSeries {
         } else {
             self.theta(tau) / (1.0 - tau * tau).sqrt()
         }
+    }
+
+    /// [`Self::density`] at four points (bit-identical, [`chebyshev_t_sum4`]).
+    pub fn density4(&self, tau: [f64; 4]) -> [f64; 4] {
+        let theta = chebyshev_t_sum4(&self.gamma, tau);
+        std::array::from_fn(|l| {
+            if tau[l].abs() >= 1.0 {
+                0.0
+            } else {
+                theta[l] / (1.0 - tau[l] * tau[l]).sqrt()
+            }
+        })
     }
 
     /// The start of [`Self::density_row`] for [`RowMatrix::fill_recurrence_rows`]:
@@ -798,27 +840,38 @@ mod tests {
     #[test]
     fn four_point_sums_equal_the_one_point_sums() {
         for len in [0, 1, 2, 3, 64, 127] {
-            let series = BoundedSeries {
-                beta: (0..len)
-                    .map(|k| (0.7 * k as f64 + 0.3).sin() / (1.0 + k as f64))
-                    .collect(),
+            let beta: Vec<f64> = (0..len)
+                .map(|k| (0.7 * k as f64 + 0.3).sin() / (1.0 + k as f64))
+                .collect();
+            let bounded = BoundedSeries { beta: beta.clone() };
+            let unbounded = UnboundedSeries {
+                gamma: beta.clone(),
             };
-            // Inside, at the ends and outside [−1, 1] (density zero there).
+            // Inside, at the ends and outside [−1, 1] (densities zero there, the transform
+            // from its exterior form).
             for tau in [[-0.9999, -0.3, 0.0, 0.77], [1.0, -1.0, 1.5, 0.999_999]] {
-                let (sums, densities) = (chebyshev_u_sum4(&series.beta, tau), series.density4(tau));
-                for l in 0..4 {
-                    assert_eq!(
-                        sums[l].to_bits(),
-                        chebyshev_u_sum(&series.beta, tau[l]).to_bits(),
-                        "{len} terms at {}",
-                        tau[l]
-                    );
-                    assert_eq!(
-                        densities[l].to_bits(),
-                        series.density(tau[l]).to_bits(),
-                        "{len} terms at {}",
-                        tau[l]
-                    );
+                let four: [(&str, [f64; 4], &dyn Fn(f64) -> f64); 5] = [
+                    ("U sum", chebyshev_u_sum4(&beta, tau), &|t| {
+                        chebyshev_u_sum(&beta, t)
+                    }),
+                    ("T sum", chebyshev_t_sum4(&beta, tau), &|t| {
+                        chebyshev_t_sum(&beta, t)
+                    }),
+                    ("bounded", bounded.density4(tau), &|t| bounded.density(t)),
+                    ("H' bounded", bounded.cauchy4(tau), &|t| bounded.cauchy(t)),
+                    ("unbounded", unbounded.density4(tau), &|t| {
+                        unbounded.density(t)
+                    }),
+                ];
+                for (name, got, one) in four {
+                    for l in 0..4 {
+                        assert_eq!(
+                            got[l].to_bits(),
+                            one(tau[l]).to_bits(),
+                            "{name}, {len} terms at {}",
+                            tau[l]
+                        );
+                    }
                 }
             }
         }

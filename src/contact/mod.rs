@@ -638,6 +638,22 @@ pub fn kink_cauchy(u: f64) -> f64 {
     }
 }
 
+/// `f` at each of `xs` into `out`, four points at a time by `f4`, which must give `f`'s values
+/// bit for bit (the four-point Chebyshev sums of [`crate::quadrature`]).
+fn in_fours(
+    xs: &[f64],
+    f4: impl Fn([f64; 4]) -> [f64; 4],
+    f: impl Fn(f64) -> f64,
+    out: &mut Vec<f64>,
+) {
+    out.clear();
+    let mut chunks = xs.chunks_exact(4);
+    for c in chunks.by_ref() {
+        out.extend(f4([c[0], c[1], c[2], c[3]]));
+    }
+    out.extend(chunks.remainder().iter().map(|&x| f(x)));
+}
+
 impl StickZone {
     /// A zone with its own correction only.
     pub fn new(lo: f64, hi: f64, correction: BoundedSeries, kink: f64) -> Self {
@@ -717,23 +733,14 @@ impl StickZone {
     /// [`Self::correction_at`] at each of `xs` into `out` (bit-identical; the own series is
     /// summed four points at a time, [`BoundedSeries::density4`], and the chain in batches).
     pub fn corrections_into(&self, xs: &[f64], out: &mut Vec<f64>) {
-        out.clear();
         let (mid, half) = (self.mid(), self.half());
-        let mut chunks = xs.chunks_exact(4);
-        for chunk in chunks.by_ref() {
-            let u: [f64; 4] = std::array::from_fn(|l| (chunk[l] - mid) / half);
-            let series = if self.correction.beta.is_empty() {
-                None
-            } else {
-                Some(self.correction.density4(u))
-            };
-            for l in 0..4 {
-                out.push(self.own_with(u[l], series.map(|s| s[l]), kink_density));
-            }
-        }
-        for &x in chunks.remainder() {
-            out.push(self.own_part(x, BoundedSeries::density, kink_density));
-        }
+        let own4 = |x: [f64; 4]| {
+            let u = x.map(|x| (x - mid) / half);
+            let series = (!self.correction.beta.is_empty()).then(|| self.correction.density4(u));
+            std::array::from_fn(|l| self.own_with(u[l], series.map(|s| s[l]), kink_density))
+        };
+        let own = |x| self.own_part(x, BoundedSeries::density, kink_density);
+        in_fours(xs, own4, own, out);
         if let Some(link) = &self.inherited {
             let mut inner = Vec::with_capacity(xs.len());
             link.values_into(xs, &mut inner);
@@ -1096,6 +1103,55 @@ impl ContactState {
         base + stick.correction_at(x)
     }
 
+    /// [`Self::pressure_at`] at each of `xs` into `out` (bit-identical, the series four points
+    /// at a time).
+    pub fn pressures_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        let tau4 = |x: [f64; 4]| x.map(|x| self.tau(x));
+        let series4 = |x| self.pressure.density4(tau4(x));
+        in_fours(xs, series4, |x| self.pressure.density(self.tau(x)), out);
+        for (o, &x) in out.iter_mut().zip(xs) {
+            *o += self.kinks_at(&self.pressure_kinks, x);
+        }
+    }
+
+    /// [`Self::potential_charge_at`] at each of `xs` into `out` (bit-identical).
+    pub fn potential_charges_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        let tau4 = |x: [f64; 4]| x.map(|x| self.tau(x));
+        let series4 = |x| self.potential_charge.density4(tau4(x));
+        let series = |x| self.potential_charge.density(self.tau(x));
+        in_fours(xs, series4, series, out);
+        for (o, &x) in out.iter_mut().zip(xs) {
+            *o += self.kinks_at(&self.charge_kinks, x);
+        }
+    }
+
+    /// [`Self::pressure_cauchy`] at each of `xs` into `out` (bit-identical).
+    pub fn pressure_cauchys_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        let tau4 = |x: [f64; 4]| x.map(|x| self.tau(x));
+        let series4 = |x| self.pressure.cauchy4(tau4(x));
+        in_fours(xs, series4, |x| self.pressure.cauchy(self.tau(x)), out);
+        for (o, &x) in out.iter_mut().zip(xs) {
+            *o += self.kinks_with(&self.pressure_kinks, |u, v| half_ellipse_cauchy(x, u, v));
+        }
+    }
+
+    /// [`Self::traction_at`] at each of `xs` into `out` (bit-identical, in batches).
+    pub fn tractions_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        let t = &self.traction;
+        let Some(stick) = &t.stick else {
+            out.resize(xs.len(), 0.0);
+            return;
+        };
+        let (mut p, mut chain) = (Vec::new(), Vec::new());
+        self.pressures_into(xs, &mut p);
+        stick.corrections_into(xs, &mut chain);
+        for ((&x, p), c) in xs.iter().zip(p).zip(chain) {
+            let base = t.friction * p * self.slip_shape(x);
+            out.push(base + c);
+        }
+    }
+
     /// `H'p(x) = (1/π)⨍ p(s)/(s − x) ds` from the representation (Pa), any x off the ends.
     pub fn pressure_cauchy(&self, x: f64) -> f64 {
         self.pressure.cauchy(self.tau(x))
@@ -1115,10 +1171,17 @@ impl ContactState {
     /// sine-graded Gauss–Legendre rules (which also absorb the √ at the contact ends). When
     /// both slip zones have the same sign S is constant and the integral vanishes.
     pub fn shape_cauchy(&self, x: f64) -> f64 {
+        let Some(stick) = &self.traction.stick else {
+            return 0.0;
+        };
+        self.shape_cauchy_with(stick, x, self.pressure_cauchy(x))
+    }
+
+    /// [`Self::shape_cauchy`] at x in the stick zone `stick`'s state, given `H'p(x)`.
+    fn shape_cauchy_with(&self, stick: &StickZone, x: f64, pressure_cauchy: f64) -> f64 {
         let t = &self.traction;
-        let Some(stick) = &t.stick else { return 0.0 };
         let sx = self.slip_shape(x);
-        let value = sx * self.pressure_cauchy(x);
+        let value = sx * pressure_cauchy;
         if (t.left_sign - t.right_sign).abs() <= 0.0 && self.shape_table.is_none() {
             return value;
         }
@@ -1216,22 +1279,26 @@ impl ContactState {
     /// zone's chain in a batch, [`StickZone::correction_cauchys_into`]).
     pub fn strains_into(&self, model: &ContactModel, xs: &[f64], out: &mut Vec<f64>) {
         out.clear();
-        let mut chain = Vec::new();
+        let (mut p, mut w) = (Vec::new(), Vec::new());
+        self.pressures_into(xs, &mut p);
+        self.potential_charges_into(xs, &mut w);
+        let (mut p_cauchy, mut chain) = (Vec::new(), Vec::new());
         if let Some(stick) = &self.traction.stick {
+            self.pressure_cauchys_into(xs, &mut p_cauchy);
             stick.correction_cauchys_into(xs, &mut chain);
         }
         let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
         let local = model.local_pressure_strain(self.split);
         for (k, &x) in xs.iter().enumerate() {
-            // `traction_cauchy` with the chain's part from the batch.
+            // `traction_cauchy` with its parts from the batches.
             let traction_cauchy = match &self.traction.stick {
                 None => 0.0,
-                Some(_) => self.traction.friction * self.shape_cauchy(x) + chain[k],
+                Some(stick) => {
+                    let shape = self.shape_cauchy_with(stick, x, p_cauchy[k]);
+                    self.traction.friction * shape + chain[k]
+                }
             };
-            out.push(
-                -local * self.pressure_at(x) - w13 * self.potential_charge_at(x)
-                    + model.compliance.y11 * traction_cauchy,
-            );
+            out.push(-local * p[k] - w13 * w[k] + model.compliance.y11 * traction_cauchy);
         }
     }
 }

@@ -1607,23 +1607,33 @@ pub fn assess_step(
         min_pressure: 1.0,
         worst_at: [f64::NAN; 3],
     };
-    for i in 1..400 {
-        let x = c + a * (-1.0 + 2.0 * i as f64 / 400.0);
-        let ratio = new.pressure_at(x) / p0;
+    let (mut p, mut q) = (Vec::new(), Vec::new());
+    let xs: Vec<f64> = (1..400)
+        .map(|i| c + a * (-1.0 + 2.0 * i as f64 / 400.0))
+        .collect();
+    new.pressures_into(&xs, &mut p);
+    for (&x, p) in xs.iter().zip(&p) {
+        let ratio = p / p0;
         if ratio < out.min_pressure {
             out.min_pressure = ratio;
             out.worst_at[2] = x;
         }
     }
-    for i in 0..=200 {
-        // The end itself exactly: a point rounded just inside an end would see q̃'s square
-        // root of the rounding error (about 2e−9 η p0 at 1e−21 m).
-        let x = if i == 200 {
-            stick.hi
-        } else {
-            stick.lo + (stick.hi - stick.lo) * i as f64 / 200.0
-        };
-        let excess = (new.traction_at(x).abs() - eta * new.pressure_at(x)) / (eta * p0);
+    // The end itself exactly: a point rounded just inside an end would see q̃'s square root of
+    // the rounding error (about 2e−9 η p0 at 1e−21 m).
+    let xs: Vec<f64> = (0..=200)
+        .map(|i| {
+            if i == 200 {
+                stick.hi
+            } else {
+                stick.lo + (stick.hi - stick.lo) * i as f64 / 200.0
+            }
+        })
+        .collect();
+    new.pressures_into(&xs, &mut p);
+    new.tractions_into(&xs, &mut q);
+    for ((&x, p), q) in xs.iter().zip(&p).zip(&q) {
+        let excess = (q.abs() - eta * p) / (eta * p0);
         if excess > out.stick_excess {
             out.stick_excess = excess;
             out.worst_at[0] = x;

@@ -1381,6 +1381,7 @@ fn surface_displacement_quadrature_scales_with_m() {
 }
 
 /// The batched evaluations that the step solver and its checks use (`strains_into`,
+/// `pressures_into`, `potential_charges_into`, `pressure_cauchys_into`, `tractions_into`,
 /// `corrections_into`, `correction_cauchys_into`) give bit for bit the values of the
 /// one-point functions, on the states of a history through a reversal: first-loading states
 /// (the normal-loading zone faded at both ends), mixed-sign states after the reversal, and
@@ -1441,26 +1442,52 @@ fn batched_fields_equal_the_one_point_fields() {
         }
         // Runs of points with χ = 1, χ = 0 and 0 < χ < 1 interleaved.
         xs.extend([zone.lo, c, zone.hi, c, zone.lo, zone.lo + 1e-3 * a, c]);
-        let (mut strains, mut values, mut transforms) = (Vec::new(), Vec::new(), Vec::new());
-        s.strains_into(&b.model, &xs, &mut strains);
-        zone.corrections_into(&xs, &mut values);
-        zone.correction_cauchys_into(&xs, &mut transforms);
-        for (k, &x) in xs.iter().enumerate() {
-            assert_eq!(
-                strains[k].to_bits(),
-                s.strain_at(&b.model, x).to_bits(),
-                "strain at {x}"
-            );
-            assert_eq!(
-                values[k].to_bits(),
-                zone.correction_at(x).to_bits(),
-                "q̃ at {x}"
-            );
-            assert_eq!(
-                transforms[k].to_bits(),
-                zone.correction_cauchy(x).to_bits(),
-                "H'q̃ at {x}"
-            );
+        type Batch<'a> = Box<dyn Fn(&[f64], &mut Vec<f64>) + 'a>;
+        type One<'a> = Box<dyn Fn(f64) -> f64 + 'a>;
+        let pairs: [(&str, Batch, One); 7] = [
+            (
+                "strain",
+                Box::new(|xs, out| s.strains_into(&b.model, xs, out)),
+                Box::new(|x| s.strain_at(&b.model, x)),
+            ),
+            (
+                "p",
+                Box::new(|xs, out| s.pressures_into(xs, out)),
+                Box::new(|x| s.pressure_at(x)),
+            ),
+            (
+                "w",
+                Box::new(|xs, out| s.potential_charges_into(xs, out)),
+                Box::new(|x| s.potential_charge_at(x)),
+            ),
+            (
+                "H'p",
+                Box::new(|xs, out| s.pressure_cauchys_into(xs, out)),
+                Box::new(|x| s.pressure_cauchy(x)),
+            ),
+            (
+                "q",
+                Box::new(|xs, out| s.tractions_into(xs, out)),
+                Box::new(|x| s.traction_at(x)),
+            ),
+            (
+                "q̃",
+                Box::new(|xs, out| zone.corrections_into(xs, out)),
+                Box::new(|x| zone.correction_at(x)),
+            ),
+            (
+                "H'q̃",
+                Box::new(|xs, out| zone.correction_cauchys_into(xs, out)),
+                Box::new(|x| zone.correction_cauchy(x)),
+            ),
+        ];
+        let mut batch = Vec::new();
+        for (name, many, one) in pairs {
+            many(&xs, &mut batch);
+            assert_eq!(batch.len(), xs.len(), "{name}");
+            for (v, &x) in batch.iter().zip(&xs) {
+                assert_eq!(v.to_bits(), one(x).to_bits(), "{name} at {x}");
+            }
         }
     }
     eprintln!(
