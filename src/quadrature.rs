@@ -850,7 +850,8 @@ mod tests {
             // Inside, at the ends and outside [−1, 1] (densities zero there, the transform
             // from its exterior form).
             for tau in [[-0.9999, -0.3, 0.0, 0.77], [1.0, -1.0, 1.5, 0.999_999]] {
-                let four: [(&str, [f64; 4], &dyn Fn(f64) -> f64); 5] = [
+                type Case<'a> = (&'a str, [f64; 4], &'a dyn Fn(f64) -> f64);
+                let four: [Case; 5] = [
                     ("U sum", chebyshev_u_sum4(&beta, tau), &|t| {
                         chebyshev_u_sum(&beta, t)
                     }),
