@@ -1381,6 +1381,16 @@ pub fn slip_zone_rule_nodes(m: usize) -> usize {
 /// both ends, which absorbs square-root and logarithmic behaviour there: every point where f
 /// is not smooth must be among `points`).
 pub fn graded_integral(points: Vec<f64>, nodes: usize, f: &dyn Fn(f64) -> f64) -> f64 {
+    graded_rule_with(nodes).integral(points, &|xs, out| out.extend(xs.iter().map(|&x| f(x))))
+}
+
+/// [`graded_integral`] with f evaluated a piece's nodes at a time, as in
+/// [`graded_cumulative_batch`].
+pub fn graded_integral_batch(
+    points: Vec<f64>,
+    nodes: usize,
+    f: &dyn Fn(&[f64], &mut Vec<f64>),
+) -> f64 {
     graded_rule_with(nodes).integral(points, f)
 }
 
@@ -1451,17 +1461,17 @@ impl GradedRule {
     }
 
     /// `∫ f` over the balanced pieces between `points` (see [`piece_ends`]).
-    fn integral(&self, points: Vec<f64>, f: &dyn Fn(f64) -> f64) -> f64 {
+    fn integral(&self, points: Vec<f64>, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> f64 {
+        let (mut at, mut values) = (Vec::new(), Vec::new());
         piece_ends(points)
             .windows(2)
             .map(|w| {
                 let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-                let sum: f64 = self
-                    .nodes
-                    .iter()
-                    .zip(&self.weights)
-                    .map(|(u, wt)| wt * f(mid + half * u))
-                    .sum();
+                at.clear();
+                at.extend(self.nodes.iter().map(|u| mid + half * u));
+                values.clear();
+                f(&at, &mut values);
+                let sum: f64 = self.weights.iter().zip(&values).map(|(wt, v)| wt * v).sum();
                 half * sum
             })
             .sum()
@@ -1625,6 +1635,20 @@ impl ContactState {
     /// 8e−7 V).
     pub fn contact_integral(&self, split: Option<f64>, f: &dyn Fn(f64) -> f64) -> f64 {
         graded_integral(
+            self.contact_points(split),
+            field_rule_nodes(self.pressure.beta.len()),
+            f,
+        )
+    }
+
+    /// [`Self::contact_integral`] with f evaluated a piece's nodes at a time
+    /// ([`graded_integral_batch`]).
+    pub fn contact_integral_batch(
+        &self,
+        split: Option<f64>,
+        f: &dyn Fn(&[f64], &mut Vec<f64>),
+    ) -> f64 {
+        graded_integral_batch(
             self.contact_points(split),
             field_rule_nodes(self.pressure.beta.len()),
             f,

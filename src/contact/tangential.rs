@@ -588,7 +588,12 @@ impl StepProblem<'_> {
         let stick = state.traction.stick.as_ref().expect("set above");
         let shape_force = if (self.signs.0 - self.signs.1).abs() > 0.0 {
             // ∫ p S dx over the contact, piecewise by the graded rule.
-            state.contact_integral(None, &|x| state.pressure_at(x) * state.slip_shape(x))
+            state.contact_integral_batch(None, &|xs, out| {
+                state.pressures_into(xs, out);
+                for (p, &x) in out.iter_mut().zip(xs) {
+                    *p *= state.slip_shape(x);
+                }
+            })
         } else {
             self.signs.1 * pressure_force
         };
@@ -918,13 +923,11 @@ impl InnerMaps {
         // The stick points lie inside the contact, where `cauchy_row` is the T recurrence.
         let taus: Vec<f64> = stick_points.iter().map(|&xs| (xs - c) / a).collect();
         debug_assert!(taus.iter().all(|t| t.abs() < 1.0));
-        stick_from_p.reset(rows, m);
-        stick_from_p.fill_recurrence_rows(0, &taus, |t| {
+        stick_from_p.refill_recurrence_rows(m, &taus, |t| {
             let [prev, first, scale] = BoundedSeries::density_start(t);
             [prev, first, k.local_over_y11 * scale]
         });
-        cauchy_at_stick.reset(rows, m);
-        cauchy_at_stick.fill_recurrence_rows(0, &taus, BoundedSeries::cauchy_start_inside);
+        cauchy_at_stick.refill_recurrence_rows(m, &taus, BoundedSeries::cauchy_start_inside);
         if let Some(eta_s) = k.shape {
             for i in 0..rows {
                 for (o, r) in stick_from_p
@@ -938,25 +941,24 @@ impl InnerMaps {
             // Folded into `stick_from_p`; mixed slip signs only keep it apart.
             cauchy_at_stick.reset(0, m);
         }
-        stick_from_w.reset(if k.charge.is_some() { rows } else { 0 }, m);
         if let Some(w13_over_y11) = k.charge {
-            stick_from_w.fill_recurrence_rows(0, &taus, |t| {
+            stick_from_w.refill_recurrence_rows(m, &taus, |t| {
                 let [prev, first, scale] = UnboundedSeries::density_start(t);
                 [prev, first, w13_over_y11 * scale]
             });
+        } else {
+            stick_from_w.reset(0, m);
         }
         let stick_shape: Vec<f64> = stick_points.iter().map(|&x| state.slip_shape(x)).collect();
         let (mid, half) = (stick.mid(), stick.half());
-        own_at_samples.reset(sample_points.len(), m);
         let sample_taus: Vec<f64> = sample_points.iter().map(|&xq| (xq - mid) / half).collect();
-        own_at_samples.fill_recurrence_rows(0, &sample_taus, BoundedSeries::density_start);
+        own_at_samples.refill_recurrence_rows(m, &sample_taus, BoundedSeries::density_start);
         let mut node_points = Vec::new();
         if k.shape.is_none() {
             let table = state.shape_quadrature(stick);
             node_points = table.iter().map(|&(t, _, _)| t).collect();
-            shape_nodes.reset(table.len(), m);
             let node_taus: Vec<f64> = table.iter().map(|&(t, _, _)| (t - c) / a).collect();
-            shape_nodes.fill_recurrence_rows(0, &node_taus, BoundedSeries::density_start);
+            shape_nodes.refill_recurrence_rows(m, &node_taus, BoundedSeries::density_start);
             shape_weights.reset(rows, table.len());
             for (i, (&xs, &sx)) in stick_points.iter().zip(&stick_shape).enumerate() {
                 for (wij, &(t, w, st)) in shape_weights.row_mut(i).iter_mut().zip(&table) {
