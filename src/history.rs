@@ -812,8 +812,22 @@ pub fn step_increments(
     };
     let old_ux = old_ux.unwrap_or_else(|| old.surface_displacement(model, anchor));
     let d_delta = new_ux - old_ux;
-    let q_mean = |x: f64| 0.5 * (old.traction_at(x) + new.traction_at(x));
-    let d_strain = |x: f64| new.strain_at(model, x) - old.strain_at(model, x);
+    let q_mean = |xs: &[f64], out: &mut Vec<f64>| {
+        let mut before = Vec::new();
+        new.tractions_into(xs, out);
+        old.tractions_into(xs, &mut before);
+        for (q, old) in out.iter_mut().zip(before) {
+            *q = 0.5 * (old + *q);
+        }
+    };
+    // Δε at the nodes of a table.
+    let d_strain = |table: &crate::contact::GradedTable| -> Vec<f64> {
+        let at: Vec<f64> = table.nodes.iter().map(|n| n.0).collect();
+        let (mut strain, mut before) = (Vec::new(), Vec::new());
+        new.strains_into(model, &at, &mut strain);
+        old.strains_into(model, &at, &mut before);
+        strain.iter().zip(before).map(|(n, o)| n - o).collect()
+    };
     let left_end = (old.centre - old.half_width).min(new.centre - new.half_width);
     let right_end = (old.centre + old.half_width).max(new.centre + new.half_width);
     // Measured on the default history: without the contact ends among the breakpoints the
@@ -836,19 +850,22 @@ pub fn step_increments(
             .collect();
         pts.extend([from, to]);
         let nodes = crate::contact::slip_zone_rule_nodes(new.pressure.beta.len());
-        crate::contact::graded_cumulative(pts, nodes, &q_mean)
+        crate::contact::graded_cumulative_batch(pts, nodes, &q_mean)
     };
     // Right zone: −∫_{hi}^{R} Δε(t) ∫_t^R q̄; left zone: +∫_{L}^{lo} Δε(t) ∫_L^t q̄.
     let right_table = table(stick.hi, right_end);
     let right: f64 = right_table
         .nodes
         .iter()
-        .map(|&(t, w, _, before)| w * d_strain(t) * (right_table.total - before))
+        .zip(d_strain(&right_table))
+        .map(|(&(_, w, _, before), d)| w * d * (right_table.total - before))
         .sum();
-    let left: f64 = table(left_end, stick.lo)
+    let left_table = table(left_end, stick.lo);
+    let left: f64 = left_table
         .nodes
         .iter()
-        .map(|&(t, w, _, before)| w * d_strain(t) * before)
+        .zip(d_strain(&left_table))
+        .map(|(&(_, w, _, before), d)| w * d * before)
         .sum();
     (d_delta, -right + left, new_ux)
 }
