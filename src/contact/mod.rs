@@ -1155,36 +1155,51 @@ impl ContactState {
         base + stick.correction_at(x)
     }
 
+    /// A series in the contact variable τ plus `extra(x)` at each of `xs` into `out`: the
+    /// series four points at a time by `four`, which must give `one`'s values bit for bit.
+    fn contact_series_into(
+        &self,
+        xs: &[f64],
+        four: impl Fn([f64; 4]) -> [f64; 4],
+        one: impl Fn(f64) -> f64,
+        extra: impl Fn(f64) -> f64,
+        out: &mut Vec<f64>,
+    ) {
+        in_fours(
+            xs,
+            |x| four(x.map(|x| self.tau(x))),
+            |x| one(self.tau(x)),
+            out,
+        );
+        for (o, &x) in out.iter_mut().zip(xs) {
+            *o += extra(x);
+        }
+    }
+
     /// [`Self::pressure_at`] at each of `xs` into `out` (bit-identical, the series four points
     /// at a time).
     pub fn pressures_into(&self, xs: &[f64], out: &mut Vec<f64>) {
-        let tau4 = |x: [f64; 4]| x.map(|x| self.tau(x));
-        let series4 = |x| self.pressure.density4(tau4(x));
-        in_fours(xs, series4, |x| self.pressure.density(self.tau(x)), out);
-        for (o, &x) in out.iter_mut().zip(xs) {
-            *o += self.kinks_at(&self.pressure_kinks, x);
-        }
+        let (series, kinks) = (&self.pressure, &self.pressure_kinks);
+        let four = |t| series.density4(t);
+        let one = |t| series.density(t);
+        self.contact_series_into(xs, four, one, |x| self.kinks_at(kinks, x), out);
     }
 
     /// [`Self::potential_charge_at`] at each of `xs` into `out` (bit-identical).
     pub fn potential_charges_into(&self, xs: &[f64], out: &mut Vec<f64>) {
-        let tau4 = |x: [f64; 4]| x.map(|x| self.tau(x));
-        let series4 = |x| self.potential_charge.density4(tau4(x));
-        let series = |x| self.potential_charge.density(self.tau(x));
-        in_fours(xs, series4, series, out);
-        for (o, &x) in out.iter_mut().zip(xs) {
-            *o += self.kinks_at(&self.charge_kinks, x);
-        }
+        let (series, kinks) = (&self.potential_charge, &self.charge_kinks);
+        let four = |t| series.density4(t);
+        let one = |t| series.density(t);
+        self.contact_series_into(xs, four, one, |x| self.kinks_at(kinks, x), out);
     }
 
     /// [`Self::pressure_cauchy`] at each of `xs` into `out` (bit-identical).
     pub fn pressure_cauchys_into(&self, xs: &[f64], out: &mut Vec<f64>) {
-        let tau4 = |x: [f64; 4]| x.map(|x| self.tau(x));
-        let series4 = |x| self.pressure.cauchy4(tau4(x));
-        in_fours(xs, series4, |x| self.pressure.cauchy(self.tau(x)), out);
-        for (o, &x) in out.iter_mut().zip(xs) {
-            *o += self.kinks_with(&self.pressure_kinks, |u, v| half_ellipse_cauchy(x, u, v));
-        }
+        let (series, kinks) = (&self.pressure, &self.pressure_kinks);
+        let four = |t| series.cauchy4(t);
+        let one = |t| series.cauchy(t);
+        let extra = |x| self.kinks_with(kinks, |u, v| half_ellipse_cauchy(x, u, v));
+        self.contact_series_into(xs, four, one, extra, out);
     }
 
     /// [`Self::traction_at`] at each of `xs` into `out` (bit-identical, in batches).
