@@ -916,44 +916,65 @@ pub fn run_history(
     }
     steps.extend(history.steps().into_iter().map(|(_, t, q)| (t, q)));
     // Pipelined on two threads: a step's increments (δ, dissipation, δn: a third of the work
-    // of a step) need only its two states, so they are computed while the next step is
-    // solved; steps are finished in order, so records, δ and the observer's calls are those
-    // of the sequential `advance`.
-    /// A solved step and the thread computing its increments.
-    type Pending<'scope> = Option<(
-        Box<SolvedStep>,
-        std::thread::ScopedJoinHandle<'scope, StepIncrements>,
-    )>;
-    let finish = |pending: Pending<'_>,
+    // of a step) need only its two states, so they are computed on a worker thread while the
+    // next step is solved; steps are finished in order, so records, δ and the observer's calls
+    // are those of the sequential `advance`. One worker for the run (a thread spawned per
+    // step cost its stack mappings and wake-ups at every step).
+    let finish = |pending: Option<Box<SolvedStep>>,
+                  results: &std::sync::mpsc::Receiver<StepIncrements>,
                   driver: &mut DriverState,
                   records: &mut Vec<StepRecord>,
                   observer: &mut dyn Observer| {
-        if let Some((solved, handle)) = pending {
-            let increments = handle
-                .join()
+        if let Some(solved) = pending {
+            let increments = results
+                .recv()
                 .expect("the increments of a step do not panic");
             records.push(finish_step(driver, *solved, increments, observer));
         }
     };
     let failure = std::thread::scope(|scope| {
-        let mut pending: Pending<'_> = None;
+        let (jobs, inbox) = std::sync::mpsc::channel::<IncrementInputs>();
+        let (outbox, results) = std::sync::mpsc::channel();
+        scope.spawn(move || {
+            for inputs in inbox {
+                if outbox
+                    .send(StepIncrements::compute(model, &inputs))
+                    .is_err()
+                {
+                    break;
+                }
+            }
+        });
+        let mut pending: Option<Box<SolvedStep>> = None;
         for (i, (t, q)) in steps.into_iter().enumerate() {
             let point = LoadPoint { step: i + 1, t, q };
             let solved = solve_step(model, disc, &mut driver, point, options);
-            finish(pending.take(), &mut driver, &mut records, observer);
+            finish(
+                pending.take(),
+                &results,
+                &mut driver,
+                &mut records,
+                observer,
+            );
             match solved {
                 Ok(Solved::Hold(regime)) => {
                     records.push(hold_record(&driver, point, regime, observer));
                 }
                 Ok(Solved::Slip(solved)) => {
-                    let inputs = solved.increment_inputs(&driver);
-                    let handle = scope.spawn(move || StepIncrements::compute(model, &inputs));
-                    pending = Some((solved, handle));
+                    jobs.send(solved.increment_inputs(&driver))
+                        .expect("the increments worker runs until the steps end");
+                    pending = Some(solved);
                 }
                 Err(failure) => return Some(failure),
             }
         }
-        finish(pending.take(), &mut driver, &mut records, observer);
+        finish(
+            pending.take(),
+            &results,
+            &mut driver,
+            &mut records,
+            observer,
+        );
         None
     });
     match failure {
