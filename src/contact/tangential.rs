@@ -1014,6 +1014,7 @@ struct Anderson {
 
 impl Anderson {
     fn new(depth: usize) -> Self {
+        assert!(depth <= SMALL, "Anderson depth at most {SMALL}");
         Self {
             depth,
             started: false,
@@ -1056,23 +1057,21 @@ impl Anderson {
         }
         // Normal equations of min |res − ΔR γ| (k ≤ depth), lightly regularised.
         let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(u, v)| u * v).sum::<f64>();
-        let mut gram: Vec<Vec<f64>> = self
-            .d_res
-            .iter()
-            .map(|di| {
-                let mut row: Vec<f64> = self.d_res.iter().map(|dj| dot(di, dj)).collect();
-                row.push(dot(di, &self.res));
-                row
-            })
-            .collect();
+        let mut gram = [[0.0; SMALL + 1]; SMALL];
+        for (row, di) in gram.iter_mut().zip(&self.d_res) {
+            for (g, dj) in row.iter_mut().zip(&self.d_res) {
+                *g = dot(di, dj);
+            }
+            row[k] = dot(di, &self.res);
+        }
         let trace: f64 = (0..k).map(|i| gram[i][i]).sum::<f64>().max(1e-300);
-        for (i, row) in gram.iter_mut().enumerate() {
+        for (i, row) in gram.iter_mut().take(k).enumerate() {
             row[i] += 1e-12 * trace;
         }
-        let Some(gamma) = solve_small(gram) else {
+        let Some(gamma) = solve_small(gram, k) else {
             return;
         };
-        for (i, gi) in gamma.iter().enumerate() {
+        for (i, gi) in gamma[..k].iter().enumerate() {
             for (v, d) in x.iter_mut().zip(&self.d_f[i]) {
                 *v -= gi * d;
             }
@@ -1080,11 +1079,15 @@ impl Anderson {
     }
 }
 
-/// Solve a small dense system given as rows `[A | b]` by Gaussian elimination with partial
-/// pivoting.
+/// Most unknowns of [`solve_small`] (and the deepest Anderson history).
+const SMALL: usize = 5;
+
+/// Solve the `n × n` system (`n ≤ SMALL`) in the first n rows `[A | b]` of `rows` (b in column
+/// n) by Gaussian elimination with partial pivoting; the solution in the first n entries. On
+/// the stack: it runs at every pass of the inner iteration.
 #[allow(clippy::needless_range_loop)]
-fn solve_small(mut rows: Vec<Vec<f64>>) -> Option<Vec<f64>> {
-    let n = rows.len();
+fn solve_small(mut rows: [[f64; SMALL + 1]; SMALL], n: usize) -> Option<[f64; SMALL]> {
+    debug_assert!(n <= SMALL);
     for col in 0..n {
         let piv = (col..n).max_by(|&x, &y| rows[x][col].abs().total_cmp(&rows[y][col].abs()))?;
         if rows[piv][col].abs() < 1e-300 {
@@ -1098,12 +1101,12 @@ fn solve_small(mut rows: Vec<Vec<f64>>) -> Option<Vec<f64>> {
             }
         }
     }
-    let mut x = vec![0.0; n];
+    let mut x = [0.0; SMALL];
     for row in (0..n).rev() {
         let s: f64 = (row + 1..n).map(|k| rows[row][k] * x[k]).sum();
         x[row] = (rows[row][n] - s) / rows[row][row];
     }
-    x.iter().all(|v| v.is_finite()).then_some(x)
+    x[..n].iter().all(|v| v.is_finite()).then_some(x)
 }
 
 fn norm(r: &[f64; 4]) -> f64 {
@@ -1112,12 +1115,12 @@ fn norm(r: &[f64; 4]) -> f64 {
 
 /// Solve the 4×4 linear system `J dx = −r` (see [`solve_small`]).
 fn solve4(j: [[f64; 4]; 4], r: [f64; 4]) -> Option<[f64; 4]> {
-    let rows = j
-        .iter()
-        .zip(r)
-        .map(|(row, ri)| row.iter().copied().chain([-ri]).collect())
-        .collect();
-    solve_small(rows).map(|x| [x[0], x[1], x[2], x[3]])
+    let mut rows = [[0.0; SMALL + 1]; SMALL];
+    for ((row, ji), ri) in rows.iter_mut().zip(j).zip(r) {
+        row[..4].copy_from_slice(&ji);
+        row[4] = -ri;
+    }
+    solve_small(rows, 4).map(|x| [x[0], x[1], x[2], x[3]])
 }
 
 /// What a step passes to the next one of the same phase: its slip signs and Jacobian.
@@ -1733,4 +1736,45 @@ pub fn assess_step(
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `solve_small` on every size up to `SMALL`: a system with a known solution whose first
+    /// pivot is zero (so rows must be swapped) is solved to round-off, and a singular one is
+    /// refused.
+    #[test]
+    fn small_systems_are_solved_with_pivoting() {
+        for n in 1..=SMALL {
+            let want: Vec<f64> = (0..n).map(|i| 1.0 + 0.5 * i as f64).collect();
+            let mut rows = [[0.0; SMALL + 1]; SMALL];
+            for (i, row) in rows.iter_mut().take(n).enumerate() {
+                for (j, a) in row.iter_mut().take(n).enumerate() {
+                    // Zero on the first diagonal entry (n > 1), diagonally heavy elsewhere.
+                    *a = if i == j && (i > 0 || n == 1) {
+                        4.0 + i as f64
+                    } else if i == j {
+                        0.0
+                    } else {
+                        1.0 / (1.0 + (i + 2 * j) as f64)
+                    };
+                }
+                row[n] = (0..n).map(|j| row[j] * want[j]).sum();
+            }
+            let got = solve_small(rows, n).expect("regular system");
+            for (g, w) in got.iter().zip(&want) {
+                assert!((g - w).abs() < 1e-13, "n = {n}: {g} against {w}");
+            }
+            if n > 1 {
+                let mut singular = rows;
+                singular[1] = singular[0];
+                assert!(
+                    solve_small(singular, n).is_none(),
+                    "n = {n}: singular accepted"
+                );
+            }
+        }
+    }
 }
