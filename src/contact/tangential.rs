@@ -262,7 +262,9 @@ impl StepProblem<'_> {
         guess: &ContactState,
         inner_tolerance: f64,
     ) -> Result<([f64; 4], ContactState, bool), SolveFailure> {
-        let inherited = self.base.and_then(|b| b.inheritance_for(g.lo, g.hi));
+        let inherited = self
+            .base
+            .and_then(|b| b.inheritance_for(g.lo, g.hi, self.disc.nodes()));
         self.evaluate_with(g, guess, inherited, inner_tolerance)
     }
 
