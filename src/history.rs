@@ -920,18 +920,6 @@ pub fn run_history(
     // next step is solved; steps are finished in order, so records, δ and the observer's calls
     // are those of the sequential `advance`. One worker for the run (a thread spawned per
     // step cost its stack mappings and wake-ups at every step).
-    let finish = |pending: Option<Box<SolvedStep>>,
-                  results: &std::sync::mpsc::Receiver<StepIncrements>,
-                  driver: &mut DriverState,
-                  records: &mut Vec<StepRecord>,
-                  observer: &mut dyn Observer| {
-        if let Some(solved) = pending {
-            let increments = results
-                .recv()
-                .expect("the increments of a step do not panic");
-            records.push(finish_step(driver, *solved, increments, observer));
-        }
-    };
     let failure = std::thread::scope(|scope| {
         let (jobs, inbox) = std::sync::mpsc::channel::<IncrementInputs>();
         let (outbox, results) = std::sync::mpsc::channel();
@@ -945,17 +933,22 @@ pub fn run_history(
                 }
             }
         });
+        let finish = |pending: Option<Box<SolvedStep>>,
+                      driver: &mut DriverState,
+                      records: &mut Vec<StepRecord>,
+                      observer: &mut dyn Observer| {
+            if let Some(solved) = pending {
+                let increments = results
+                    .recv()
+                    .expect("the increments of a step do not panic");
+                records.push(finish_step(driver, *solved, increments, observer));
+            }
+        };
         let mut pending: Option<Box<SolvedStep>> = None;
         for (i, (t, q)) in steps.into_iter().enumerate() {
             let point = LoadPoint { step: i + 1, t, q };
             let solved = solve_step(model, disc, &mut driver, point, options);
-            finish(
-                pending.take(),
-                &results,
-                &mut driver,
-                &mut records,
-                observer,
-            );
+            finish(pending.take(), &mut driver, &mut records, observer);
             match solved {
                 Ok(Solved::Hold(regime)) => {
                     records.push(hold_record(&driver, point, regime, observer));
@@ -968,13 +961,7 @@ pub fn run_history(
                 Err(failure) => return Some(failure),
             }
         }
-        finish(
-            pending.take(),
-            &results,
-            &mut driver,
-            &mut records,
-            observer,
-        );
+        finish(pending.take(), &mut driver, &mut records, observer);
         None
     });
     match failure {
