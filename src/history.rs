@@ -823,10 +823,9 @@ pub fn step_increments(
     // Δε at the nodes of a table.
     let d_strain = |table: &crate::contact::GradedTable| -> Vec<f64> {
         let at: Vec<f64> = table.nodes.iter().map(|n| n.0).collect();
-        let (mut strain, mut before) = (Vec::new(), Vec::new());
-        new.strains_into(model, &at, &mut strain);
-        old.strains_into(model, &at, &mut before);
-        strain.iter().zip(before).map(|(n, o)| n - o).collect()
+        let mut change = Vec::with_capacity(at.len());
+        new.strain_changes_into(model, old, &at, &mut change);
+        change
     };
     let left_end = (old.centre - old.half_width).min(new.centre - new.half_width);
     let right_end = (old.centre + old.half_width).max(new.centre + new.half_width);
@@ -850,7 +849,7 @@ pub fn step_increments(
             .collect();
         pts.extend([from, to]);
         let nodes = crate::contact::slip_zone_rule_nodes(new.pressure.beta.len());
-        crate::contact::graded_cumulative_batch(pts, nodes, &q_mean)
+        crate::contact::graded_cumulative(pts, nodes, &q_mean)
     };
     // Right zone: −∫_{hi}^{R} Δε(t) ∫_t^R q̄; left zone: +∫_{L}^{lo} Δε(t) ∫_L^t q̄.
     let right_table = table(stick.hi, right_end);

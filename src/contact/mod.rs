@@ -314,8 +314,8 @@ impl CauchyTable {
                 && xs[k + 1..k + 4].iter().all(|&x| self.piece(x) == piece);
             match piece {
                 Some(p) if same => {
-                    let v = std::array::from_fn(|l| self.graded(p, xs[k + l]));
-                    out.extend(crate::quadrature::chebyshev_t_sum4(
+                    let v: [f64; 4] = std::array::from_fn(|l| self.graded(p, xs[k + l]));
+                    out.extend(crate::quadrature::chebyshev_t_sums(
                         &self.coefficients[p],
                         v,
                     ));
@@ -791,12 +791,12 @@ impl StickZone {
     }
 
     /// [`Self::correction_at`] at each of `xs` into `out` (bit-identical; the own series is
-    /// summed four points at a time, [`BoundedSeries::density4`], and the chain in batches).
+    /// summed four points at a time, [`BoundedSeries::densities`], and the chain in batches).
     pub fn corrections_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         let (mid, half) = (self.mid(), self.half());
         let own4 = |x: [f64; 4]| {
             let u = x.map(|x| (x - mid) / half);
-            let series = (!self.correction.beta.is_empty()).then(|| self.correction.density4(u));
+            let series = (!self.correction.beta.is_empty()).then(|| self.correction.densities(u));
             std::array::from_fn(|l| self.own_with(u[l], series.map(|s| s[l]), kink_density))
         };
         let own = |x| self.own_part(x, BoundedSeries::density, kink_density);
@@ -1211,7 +1211,7 @@ impl ContactState {
     /// at a time).
     pub fn pressures_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         let (series, kinks) = (&self.pressure, &self.pressure_kinks);
-        let four = |t| series.density4(t);
+        let four = |t| series.densities(t);
         let one = |t| series.density(t);
         self.contact_series_into(xs, four, one, |x| self.kinks_at(kinks, x), out);
     }
@@ -1219,7 +1219,7 @@ impl ContactState {
     /// [`Self::potential_charge_at`] at each of `xs` into `out` (bit-identical).
     pub fn potential_charges_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         let (series, kinks) = (&self.potential_charge, &self.charge_kinks);
-        let four = |t| series.density4(t);
+        let four = |t| series.densities(t);
         let one = |t| series.density(t);
         self.contact_series_into(xs, four, one, |x| self.kinks_at(kinks, x), out);
     }
@@ -1227,7 +1227,7 @@ impl ContactState {
     /// [`Self::pressure_cauchy`] at each of `xs` into `out` (bit-identical).
     pub fn pressure_cauchys_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         let (series, kinks) = (&self.pressure, &self.pressure_kinks);
-        let four = |t| series.cauchy4(t);
+        let four = |t| series.cauchys(t);
         let one = |t| series.cauchy(t);
         let extra = |x| self.kinks_with(kinks, |u, v| half_ellipse_cauchy(x, u, v));
         self.contact_series_into(xs, four, one, extra, out);
@@ -1235,18 +1235,41 @@ impl ContactState {
 
     /// [`Self::traction_at`] at each of `xs` into `out` (bit-identical, in batches).
     pub fn tractions_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        let mut p = Vec::new();
+        self.pressures_into(xs, &mut p);
+        self.tractions_with(xs, &p, out);
+    }
+
+    /// [`Self::tractions_into`] given the pressure `p` at `xs` (as from
+    /// [`Self::pressures_into`]).
+    pub fn tractions_with(&self, xs: &[f64], p: &[f64], out: &mut Vec<f64>) {
         out.clear();
         let t = &self.traction;
         let Some(stick) = &t.stick else {
             out.resize(xs.len(), 0.0);
             return;
         };
-        let (mut p, mut chain) = (Vec::new(), Vec::new());
-        self.pressures_into(xs, &mut p);
+        let mut chain = Vec::new();
         stick.corrections_into(xs, &mut chain);
         for ((&x, p), c) in xs.iter().zip(p).zip(chain) {
             let base = t.friction * p * self.slip_shape(x);
             out.push(base + c);
+        }
+    }
+
+    /// `combine(p, w)` at each of `xs` into `out`, p and w in batches: the densities of the
+    /// pressure and charge terms of the displacement integrals.
+    fn pressure_charge_into(
+        &self,
+        xs: &[f64],
+        combine: impl Fn(f64, f64) -> f64,
+        out: &mut Vec<f64>,
+    ) {
+        let mut w = Vec::new();
+        self.pressures_into(xs, out);
+        self.potential_charges_into(xs, &mut w);
+        for (p, w) in out.iter_mut().zip(w) {
+            *p = combine(*p, w);
         }
     }
 
@@ -1399,6 +1422,23 @@ impl ContactState {
             out.push(-local * p[k] - w13 * w[k] + model.compliance.y11 * traction_cauchy);
         }
     }
+
+    /// The strain change from `old` to this state, `ε − ε_old`, at each of `xs` into `out`
+    /// ([`Self::strains_into`] of both).
+    pub fn strain_changes_into(
+        &self,
+        model: &ContactModel,
+        old: &ContactState,
+        xs: &[f64],
+        out: &mut Vec<f64>,
+    ) {
+        let mut before = Vec::with_capacity(xs.len());
+        self.strains_into(model, xs, out);
+        old.strains_into(model, xs, &mut before);
+        for (n, o) in out.iter_mut().zip(before) {
+            *n -= o;
+        }
+    }
 }
 
 /// Where the strain change between two states is not smooth: both states' traction
@@ -1477,18 +1517,9 @@ pub fn slip_zone_rule_nodes(m: usize) -> usize {
 /// balanced (none more than three times as long as a neighbour, `piece_ends`), each piece by a
 /// `nodes`-point sine-graded Gauss–Legendre rule (nodes clustered like Chebyshev points at
 /// both ends, which absorbs square-root and logarithmic behaviour there: every point where f
-/// is not smooth must be among `points`).
-pub fn graded_integral(points: Vec<f64>, nodes: usize, f: &dyn Fn(f64) -> f64) -> f64 {
-    graded_rule_with(nodes).integral(points, &|xs, out| out.extend(xs.iter().map(|&x| f(x))))
-}
-
-/// [`graded_integral`] with f evaluated a piece's nodes at a time, as in
-/// [`graded_cumulative_batch`].
-pub fn graded_integral_batch(
-    points: Vec<f64>,
-    nodes: usize,
-    f: &dyn Fn(&[f64], &mut Vec<f64>),
-) -> f64 {
+/// is not smooth must be among `points`). f is evaluated a piece's nodes at a time:
+/// `f(xs, out)` pushes the values at `xs` onto `out` (passed empty).
+pub fn graded_integral(points: Vec<f64>, nodes: usize, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> f64 {
     graded_rule_with(nodes).integral(points, f)
 }
 
@@ -1496,14 +1527,9 @@ pub fn graded_integral_batch(
 /// [`graded_integral`]) together with the running integral up to each node, from the
 /// cumulative Gauss–Legendre matrix in the graded variable
 /// ([`crate::quadrature::gauss_legendre_cumulative`]). Nested integrals such as
-/// `∫ g(t) ∫_t^R f ds dt` then cost one evaluation of f per node.
-pub fn graded_cumulative(points: Vec<f64>, nodes: usize, f: &dyn Fn(f64) -> f64) -> GradedTable {
-    graded_rule_with(nodes).cumulative(points, &|xs, out| out.extend(xs.iter().map(|&x| f(x))))
-}
-
-/// [`graded_cumulative`] with f evaluated a piece's nodes at a time: `f(xs, out)` pushes the
-/// values at `xs` onto `out` (passed empty).
-pub fn graded_cumulative_batch(
+/// `∫ g(t) ∫_t^R f ds dt` then cost one evaluation of f per node (f as in
+/// [`graded_integral`]).
+pub fn graded_cumulative(
     points: Vec<f64>,
     nodes: usize,
     f: &dyn Fn(&[f64], &mut Vec<f64>),
@@ -1742,22 +1768,8 @@ impl ContactState {
     /// breakpoints (it was missing before), the arcsine moment's φ0 over the default history
     /// agrees with a 256-node rule to 1e−10 V of 17 V (the 96-node rule without the kink point:
     /// 8e−7 V).
-    pub fn contact_integral(&self, split: Option<f64>, f: &dyn Fn(f64) -> f64) -> f64 {
+    pub fn contact_integral(&self, split: Option<f64>, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> f64 {
         graded_integral(
-            self.contact_points(split),
-            field_rule_nodes(self.pressure.beta.len()),
-            f,
-        )
-    }
-
-    /// [`Self::contact_integral`] with f evaluated a piece's nodes at a time
-    /// ([`graded_integral_batch`]).
-    pub fn contact_integral_batch(
-        &self,
-        split: Option<f64>,
-        f: &dyn Fn(&[f64], &mut Vec<f64>),
-    ) -> f64 {
-        graded_integral_batch(
             self.contact_points(split),
             field_rule_nodes(self.pressure.beta.len()),
             f,
@@ -1787,12 +1799,7 @@ impl ContactState {
         let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);
         let local = model.local_pressure_strain(self.split);
         let local_density = |xs: &[f64], out: &mut Vec<f64>| {
-            let mut w = Vec::new();
-            self.pressures_into(xs, out);
-            self.potential_charges_into(xs, &mut w);
-            for (p, w) in out.iter_mut().zip(w) {
-                *p = local * *p + w13 * w;
-            }
+            self.pressure_charge_into(xs, |p, w| local * p + w13 * w, out);
         };
         let traction = |xs: &[f64], out: &mut Vec<f64>| self.tractions_into(xs, out);
         -0.5 * self.sign_integral(x, &local_density)
@@ -1801,9 +1808,9 @@ impl ContactState {
     }
 
     /// `∫ f(s) sign(x − s) ds` over the contact (f evaluated a batch of points at a time,
-    /// [`Self::contact_integral_batch`]).
+    /// [`Self::contact_integral`]).
     fn sign_integral(&self, x: f64, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> f64 {
-        self.contact_integral_batch(Some(x), &|xs, out| {
+        self.contact_integral(Some(x), &|xs, out| {
             f(xs, out);
             for (v, s) in out.iter_mut().zip(xs) {
                 *v *= (x - s).signum();
@@ -1835,7 +1842,7 @@ impl ContactState {
                 *v = (*v - f_x) * log_distance(s);
             }
         };
-        self.contact_integral_batch(Some(x), &integrand) + f_x * log_moment(lo, hi, x, d)
+        self.contact_integral(Some(x), &integrand) + f_x * log_moment(lo, hi, x, d)
     }
 
     /// Where the traction is not smooth: the stick ends, and the ends, fade ramps and centre
@@ -1857,12 +1864,8 @@ impl ContactState {
         let y23 = model.compliance.electric.map_or(0.0, |e| e.y23);
         // `y22 p + y23 g`, with `g = χ p + w` as in `charge_at`.
         let density = |xs: &[f64], out: &mut Vec<f64>| {
-            let mut w = Vec::new();
-            self.pressures_into(xs, out);
-            self.potential_charges_into(xs, &mut w);
-            for (p, w) in out.iter_mut().zip(w) {
-                *p = model.compliance.y22 * *p + y23 * (self.split.ratio * *p + w);
-            }
+            let y22 = model.compliance.y22;
+            self.pressure_charge_into(xs, |p, w| y22 * p + y23 * (self.split.ratio * p + w), out);
         };
         let traction = |xs: &[f64], out: &mut Vec<f64>| self.tractions_into(xs, out);
         0.5 * model.compliance.w12 * self.sign_integral(x, &traction)
@@ -2049,7 +2052,10 @@ mod tests {
         let x0 = -0.518976;
         let primitive = |x: f64| (x - x0) * (x - x0).abs().ln() - (x - x0);
         let want = primitive(0.4) - primitive(-0.988128);
-        let table = graded_cumulative(given, 32, &|x: f64| (x - x0).abs().ln());
+        let log = |xs: &[f64], out: &mut Vec<f64>| {
+            out.extend(xs.iter().map(|x| (x - x0).abs().ln()));
+        };
+        let table = graded_cumulative(given, 32, &log);
         let error = ((table.total - want) / want).abs();
         assert!(error < 1e-7, "relative error {error:e}");
     }

@@ -91,7 +91,7 @@ pub fn arcsine_moment(state: &ContactState) -> f64 {
         return 0.0;
     }
     let (c, a) = (state.centre, state.half_width);
-    state.contact_integral_batch(None, &|xs, out| {
+    state.contact_integral(None, &|xs, out| {
         state.tractions_into(xs, out);
         for (q, s) in out.iter_mut().zip(xs) {
             *q *= ((s - c) / a).clamp(-1.0, 1.0).asin();

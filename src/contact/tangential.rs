@@ -241,8 +241,9 @@ struct StepProblem<'a> {
     signs: (f64, f64),
     normal_load: f64,
     tangential_load: f64,
-    /// The last evaluation's [`InnerMaps`], whose matrices the next evaluation refills.
-    scratch: RefCell<InnerMaps>,
+    /// The last evaluation's [`InnerMaps`], whose matrices the next evaluation refills (one
+    /// for all the attempts of a step).
+    scratch: &'a RefCell<InnerMaps>,
 }
 
 impl StepProblem<'_> {
@@ -598,7 +599,7 @@ impl StepProblem<'_> {
         let stick = state.traction.stick.as_ref().expect("set above");
         let shape_force = if (self.signs.0 - self.signs.1).abs() > 0.0 {
             // ∫ p S dx over the contact, piecewise by the graded rule.
-            state.contact_integral_batch(None, &|xs, out| {
+            state.contact_integral(None, &|xs, out| {
                 state.pressures_into(xs, out);
                 for (p, &x) in out.iter_mut().zip(xs) {
                     *p *= state.slip_shape(x);
@@ -1222,6 +1223,7 @@ pub fn solve_slip(
         }
     }
     let mut attempts = Attempts::default();
+    let scratch = RefCell::default();
     let problem_for = |signs: (f64, f64)| StepProblem {
         model,
         disc,
@@ -1230,7 +1232,7 @@ pub fn solve_slip(
         signs,
         normal_load: start.normal_load,
         tangential_load,
-        scratch: RefCell::default(),
+        scratch: &scratch,
     };
     if let Some(step) = masing_return(&problem_for, start, sign, options, &mut attempts) {
         return Ok(step);
@@ -1657,7 +1659,7 @@ pub fn assess_step(
         })
         .collect();
     new.pressures_into(&xs, &mut p);
-    new.tractions_into(&xs, &mut q);
+    new.tractions_with(&xs, &p, &mut q);
     for ((&x, p), q) in xs.iter().zip(&p).zip(&q) {
         let excess = (q.abs() - eta * p) / (eta * p0);
         if excess > out.stick_excess {
@@ -1672,14 +1674,7 @@ pub fn assess_step(
     // `slip_zone_rule_nodes` per balanced piece give the slips to 1.2e−6 of the largest
     // (measured over the default history at M = 64 … 512 against four times the nodes), far
     // inside the check's tolerance of 1e−2.
-    let d_strain = |xs: &[f64], out: &mut Vec<f64>| {
-        let mut before = Vec::with_capacity(xs.len());
-        new.strains_into(model, xs, out);
-        old.strains_into(model, xs, &mut before);
-        for (n, o) in out.iter_mut().zip(before) {
-            *n -= o;
-        }
-    };
+    let d_strain = |xs: &[f64], out: &mut Vec<f64>| new.strain_changes_into(model, old, xs, out);
     let breaks = super::step_breakpoints(old, new);
     let mut slips = Vec::new();
     let zones = [
@@ -1708,7 +1703,7 @@ pub fn assess_step(
         pts.extend(&samples);
         pts.extend([left, right]);
         let nodes = super::slip_zone_rule_nodes(new.pressure.beta.len()) / 2;
-        let table = super::graded_cumulative_batch(pts, nodes, &d_strain);
+        let table = super::graded_cumulative(pts, nodes, &d_strain);
         for x in samples {
             // ∫ from `left` to x: the nodes of the pieces before x (x is a piece end).
             let before: f64 = table
