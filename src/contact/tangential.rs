@@ -174,6 +174,10 @@ pub struct SlipOptions {
     /// by 1e−3 a in one stick end, the size of the discretisation error of the stick ends at
     /// M = 64 (convergence study in `docs/performance.md`), and the next step is unaffected.
     pub stall_tolerance: f64,
+    /// Start a step from the same step of the last phase in the same direction that began
+    /// from the same turning state, when there is one ([`Recalled`]; the history driver keeps
+    /// them). In a steady cycle that state solves the step again, in one evaluation.
+    pub recall: bool,
 }
 
 impl Default for SlipOptions {
@@ -184,6 +188,7 @@ impl Default for SlipOptions {
             max_evaluations: 60,
             admissibility: 1e-3,
             stall_tolerance: 1e-4,
+            recall: true,
         }
     }
 }
@@ -622,6 +627,12 @@ impl StepProblem<'_> {
 /// Tolerance of the inner iteration: the largest change of the traction in a pass, relative
 /// to `η p0`.
 const INNER_TOLERANCE: f64 = 1e-14;
+
+/// Largest first residual with which a recalled step is continued ([`Recalled`]): 1e4 times
+/// the largest measured where the step's problem is the recalled one's (1.5e−13, over the
+/// 25 histories of `docs/performance.md`'s batch); a larger one means the problem differs,
+/// and the step's own attempts decide among its sign patterns.
+const RECALL_RESIDUAL: f64 = 1e-9;
 
 /// The inner tolerance of a trial iterate when the current residual norm is `residual`: an
 /// inexact Newton method, whose residuals need only be accurate to a small fraction (here
@@ -1135,11 +1146,22 @@ pub struct WarmStart {
     pub jacobian: [[f64; 4]; 4],
 }
 
+/// The accepted state of the same step (the same load) in an earlier phase of the same
+/// direction that began from the same turning state, with its slip signs and final Jacobian.
+/// In a steady cycle the step's problem is that step's again, so its geometry solves it.
+#[derive(Debug, Clone)]
+pub struct Recalled {
+    /// The earlier step's state.
+    pub state: Arc<ContactState>,
+    /// Its slip signs and Jacobian.
+    pub warm: WarmStart,
+}
+
 /// Solve one step at tangential load `tangential_load` with slip sign `sign`, starting from
 /// `start` (the previous step), stick-zone guesses tried in turn and the phase's inherited
 /// correction chain `base`. `contact`, when given, is the predicted contact half-width and
 /// centre `(a, c)` from which the attempts with the first stick-zone guess start (otherwise
-/// they start from `start`'s).
+/// they start from `start`'s). `recalled`, when given, is tried first (see [`Recalled`]).
 #[allow(clippy::too_many_arguments)]
 pub fn solve_slip(
     model: &ContactModel,
@@ -1152,6 +1174,7 @@ pub fn solve_slip(
     guesses_in: &[(f64, f64)],
     contact: Option<(f64, f64)>,
     warm: Option<&WarmStart>,
+    recalled: Option<&Recalled>,
     options: SlipOptions,
 ) -> Result<SlipStep, SolveFailure> {
     let guess = guesses_in[0];
@@ -1234,6 +1257,9 @@ pub fn solve_slip(
         tangential_load,
         scratch: &scratch,
     };
+    if let Some(step) = recalled.and_then(|r| recall(&problem_for, start, r, options)) {
+        return Ok(step);
+    }
     if let Some(step) = masing_return(&problem_for, start, sign, options, &mut attempts) {
         return Ok(step);
     }
@@ -1255,7 +1281,26 @@ pub fn solve_slip(
                 contact.filter(|_| guess == guesses_in[0] && warm.is_none_or(|w| w.signs == signs));
             match solve_geometry(&problem, start, start, (guess, contact), method, options) {
                 Ok(step) => return Ok(step),
-                Err(failed) => attempts.record(failed),
+                Err(failed) => {
+                    let retry =
+                        failed.stalled.is_some() && matches!(method, Method::Broyden(Some(_)));
+                    attempts.record(failed);
+                    // A stall from a carried Jacobian is tried once more from a fresh
+                    // finite-difference one before the stalled iterate is taken (default
+                    // history at M = 64, 20 steps per segment, the step at −0.075 ηP of the
+                    // second cycle: stalled at 1.4e−6 after 65 evaluations, converged in 10,
+                    // 7e−6 a from the stalled state; the two other stalls of the batch in
+                    // `docs/performance.md` stay stalled, at 66 and 73 more evaluations).
+                    if retry {
+                        let fresh = Method::Broyden(None);
+                        let again = (guess, contact);
+                        if let Ok(step) =
+                            solve_geometry(&problem, start, start, again, fresh, options)
+                        {
+                            return Ok(step);
+                        }
+                    }
+                }
             }
         }
     }
@@ -1264,6 +1309,23 @@ pub fn solve_slip(
         Some(step) => Ok(*step),
         None => Err(attempts.first_failure.expect("at least one attempt")),
     }
+}
+
+/// The recalled state's geometry, from its own coefficients and Jacobian; `None` (and nothing
+/// recorded: the step's own attempts follow) when its first residual exceeds
+/// [`RECALL_RESIDUAL`], i.e. the problem is not the earlier one's.
+fn recall<'a>(
+    problem_for: &dyn Fn((f64, f64)) -> StepProblem<'a>,
+    start: &ContactState,
+    recalled: &Recalled,
+    options: SlipOptions,
+) -> Option<SlipStep> {
+    let state = &recalled.state;
+    let zone = state.traction.stick.as_ref()?;
+    let guess = ((zone.lo, zone.hi), Some((state.half_width, state.centre)));
+    let problem = problem_for(recalled.warm.signs);
+    let method = Method::Recall(recalled.warm.jacobian);
+    solve_geometry(&problem, start, state, guess, method, options).ok()
 }
 
 /// Masing's memory: when the load returns to the load of a remembered turning point whose
@@ -1400,6 +1462,10 @@ enum Method {
     /// Newton's method with a finite-difference Jacobian at every iterate and five times the
     /// evaluation budget: slower, and the fallback where the quasi-Newton attempts all fail.
     Newton,
+    /// Broyden's updates from a recalled step's Jacobian, the first residual solved at the full
+    /// inner tolerance (from the recalled coefficients, a pass or two), and given up at once
+    /// when that residual exceeds [`RECALL_RESIDUAL`].
+    Recall([[f64; 4]; 4]),
 }
 
 /// Newton's method on the geometry with Broyden's rank-one updates: the Jacobian is taken
@@ -1419,6 +1485,7 @@ fn solve_geometry(
 ) -> Result<SlipStep, Failed> {
     let (hint, broyden) = match method {
         Method::Broyden(hint) => (hint, true),
+        Method::Recall(jac) => (Some(jac), true),
         Method::Newton => (None, false),
     };
     let model = problem.model;
@@ -1442,7 +1509,21 @@ fn solve_geometry(
     // solved to the loosest inner tolerance (an accepted residual is solved again at the
     // full tolerance anyway; default run: inner passes 8483 → 7707, the same evaluations,
     // the states within 2.4e−13 a).
-    let (mut r, mut state, mut tight) = problem.evaluate(&g, from, LOOSEST_INNER_TOLERANCE)?;
+    let recalled = matches!(method, Method::Recall(_));
+    let first_tolerance = if recalled {
+        INNER_TOLERANCE
+    } else {
+        LOOSEST_INNER_TOLERANCE
+    };
+    let (mut r, mut state, mut tight) = problem.evaluate(&g, from, first_tolerance)?;
+    if recalled && norm(&r) > RECALL_RESIDUAL {
+        return Err(SolveFailure::NoConvergence {
+            what: "recalled step",
+            iterations: 1,
+            residual: norm(&r),
+        }
+        .into());
+    }
     let mut evaluations = 1;
     let mut jac = hint;
     let mut fresh = false;
