@@ -119,6 +119,16 @@ fn steps(c: &mut Criterion) {
     g.finish();
 }
 
+fn recalled(c: &mut Criterion) {
+    // The same step, 0.30 → 0.35 ηP, in the third forward phase of the default history: that
+    // phase began from the same turning state (−½ ηP) as the second, whose step at 0.35 ηP
+    // it recalls (`SlipOptions::recall`).
+    let mut loads = default_loads(1);
+    loads.extend((1..=20).map(|i| 0.5 - 0.05 * i as f64));
+    loads.extend((1..=16).map(|i| -0.5 + 0.05 * i as f64));
+    bench_step(c, "solve/recalled_forward_step", &SIZES, &loads, 0.35);
+}
+
 fn reversal(c: &mut Criterion) {
     // The first step after the turning point at +½ηP.
     bench_step(c, "solve/reversal_step", &SIZES, &default_loads(0), 0.45);
@@ -198,6 +208,7 @@ criterion_group!(
     kernels,
     normal,
     steps,
+    recalled,
     reversal,
     cycle,
     steady_cycle
