@@ -32,6 +32,15 @@
 //! others stick, with new slip zones of the Mindlin–Deresiewicz width
 //! `a(1 − √(1 − |ΔQ|/(2ηP)))` at the ends that start to slip, and the contact centre moves by
 //! ΔQ times dc/dQ of the previous phase's first step.
+//!
+//! # Recall of a repeated phase
+//! The driver keeps the accepted steps of the current phase and of the last finished phase of
+//! each direction (`Traces`). When a phase begins from the same turning state as the last
+//! phase of its direction (the load to 1e−9 of ηP, stick ends, a and c to 1e−8 a), each of
+//! its steps is started from that phase's step at the same load ([`Recalled`]). In a steady
+//! cycle that step solves the new one to the tolerance in one residual evaluation. Otherwise
+//! its residual exceeds the recall limit, and the step is solved as above
+//! (`SlipOptions::recall`; measured in `docs/performance.md`, ninth session).
 
 use std::sync::Arc;
 

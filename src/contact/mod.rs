@@ -910,7 +910,7 @@ impl StickZone {
     ///
     /// The fade ramps over a quarter of the overlap of the two zones while the overlap is at
     /// least a tenth of the new zone. Below that, the ramp covers the whole overlap (from the
-    /// new end to the remembered one), provided at least [`FADE_POINTS`] of the new zone's
+    /// new end to the remembered one), provided at least `FADE_POINTS` of the new zone's
     /// collocation points fall within it; otherwise the earlier zone is passed over and its
     /// kink is left to the series. (Before the whole-overlap ramp, every overlap below a tenth
     /// was passed over.)

@@ -38,6 +38,12 @@
 //! converges, the first admissible iterate whose residual stalled below
 //! `SlipOptions::stall_tolerance` is accepted (and ends the search) and keeps its residual in
 //! the step record.
+//! A step may be started from a recalled earlier step instead ([`Recalled`]: the same load in
+//! a phase of the same direction that began from the same turning state). It is continued
+//! only when its first residual, solved at the full inner tolerance, is below
+//! `RECALL_RESIDUAL`; it is accepted by the same tolerance and checks as any other step.
+//! An attempt that stalls from a carried Jacobian is made once more from a finite-difference
+//! one before its stalled iterate is taken.
 //! (Block Gauss–Seidel between the stick ends and (a, c), as in the seed paper, falls into
 //! 2-cycles when the contact shifts at a reversal.)
 //!
