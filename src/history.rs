@@ -354,8 +354,9 @@ impl Traces {
             .map(|(_, r)| r)
     }
 
-    /// Record an accepted step (`None`: one that is not to be recalled); `start` begins a new phase (`[Q, lo, hi, a, c]` of its
-    /// turning state), and the current trace is then finished.
+    /// Record an accepted step (`None`: one that is not to be recalled); `start` begins a new
+    /// phase (`[Q, lo, hi, a, c]` of its turning state), and the current trace is then
+    /// finished.
     fn push(&mut self, start: Option<[f64; 5]>, sign: f64, q: f64, step: Option<Recalled>) {
         if let Some(start) = start {
             if let Some(done) = self.current.take() {
