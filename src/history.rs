@@ -661,7 +661,8 @@ pub fn solve_step(
 ) -> Result<Solved, StepFailure> {
     let LoadPoint { step, t, q } = point;
     let dq = q - driver.state.tangential_load;
-    let regime = next_regime(dq, 1e-12 * model.friction * driver.state.normal_load);
+    let limit = model.friction * driver.state.normal_load;
+    let regime = next_regime(dq, 1e-12 * limit);
     let Some(sign) = regime.slip_sign() else {
         return Ok(Solved::Hold(regime));
     };
@@ -712,9 +713,7 @@ pub fn solve_step(
         driver.phase_start_load
     };
     let (c, a) = (driver.state.centre, driver.state.half_width);
-    let md = (1.0
-        - ((q - start_load).abs() / (2.0 * model.friction * driver.state.normal_load)).min(0.95))
-    .sqrt();
+    let md = (1.0 - ((q - start_load).abs() / (2.0 * limit)).min(0.95)).sqrt();
     let md_guess = (c - a * md, c + a * md);
     // After a step with mixed slip signs (the first steps after a reversal, one edge still
     // slipping the old way) the previous stick ends do not continue the standard state: its
@@ -747,7 +746,6 @@ pub fn solve_step(
     } else {
         driver.traces.current.as_ref().map(|t| t.start)
     };
-    let limit = model.friction * driver.state.normal_load;
     let recalled = phase_start
         .filter(|_| options.recall)
         .and_then(|start| driver.traces.recall(&start, sign, q, limit))
@@ -813,19 +811,7 @@ pub fn solve_step(
         jacobian: solved.jacobian,
     });
     let old = std::mem::replace(&mut driver.state, solved.state.clone());
-    let stick = driver
-        .state
-        .traction
-        .stick
-        .as_ref()
-        .expect("slip state has a stick zone");
-    driver.history.push([
-        q,
-        stick.lo,
-        stick.hi,
-        driver.state.half_width,
-        driver.state.centre,
-    ]);
+    driver.history.push(load_and_geometry(&driver.state));
     if driver.history.len() > HISTORY_POINTS {
         driver.history.remove(0);
     }
