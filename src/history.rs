@@ -18,7 +18,7 @@
 //! step, t, Q and regime; the steps already solved are kept by the caller (observer).
 //!
 //! A step's increments — Δδ at the anchor, the frictional dissipation and the works of P and
-//! of the electric load ([`step_increments`], [`StepIncrements`]) — need only the step's two
+//! of the electric load ([`StepIncrements`], [`step_dissipation`]) — need only the step's two
 //! states, and the next step needs none of them, so [`run_history`] computes them on a second
 //! thread while it solves the next step ([`solve_step`], then [`finish_step`] in order);
 //! [`advance`] does the same sequentially. The records are the same either way.
@@ -529,16 +529,32 @@ pub struct StepIncrements {
 }
 
 impl StepIncrements {
-    /// The increments between `inputs.old` and `inputs.new` ([`step_increments`],
-    /// [`ContactState::normal_approach`]).
+    /// The increments between `inputs.old` and `inputs.new`.
+    ///
+    /// The punch moves rigidly, so on the new stick zone `Δux` is uniform and equals `Δδ`; it
+    /// is taken at the material point `anchor` of the stick zone. The driver keeps one anchor
+    /// for as long as it sticks, so that the increments telescope: δ is then `ux(anchor)` of
+    /// the current state plus a constant, and a cycle that repeats its states repeats δ
+    /// exactly (averaging over points that change from step to step leaves the
+    /// discretisation error of `ux` to accumulate as a drift, measured at 2e−6 of the loop's δ
+    /// range per cycle for the Figure-4 history). `ux(anchor)` and δn come from one pass over
+    /// each state ([`ContactState::displacement_and_approach`]); the old state's are taken
+    /// from `inputs` when the previous step computed them. The dissipation is
+    /// [`step_dissipation`]'s.
     pub fn compute(model: &ContactModel, inputs: &IncrementInputs) -> Self {
         let (old, new) = (&inputs.old, &inputs.new);
-        let (displacement, dissipation, new_ux) =
-            step_increments(model, old, new, inputs.anchor, inputs.old_ux);
-        let old_approach = inputs
-            .old_approach
-            .unwrap_or_else(|| old.normal_approach(model));
-        let new_approach = new.normal_approach(model);
+        let (new_ux, new_approach) = new.displacement_and_approach(model, inputs.anchor);
+        let (old_ux, old_approach) = match (inputs.old_ux, inputs.old_approach) {
+            (Some(ux), Some(approach)) => (ux, approach),
+            (ux, approach) => {
+                let (u, n) = old.displacement_and_approach(model, inputs.anchor);
+                (ux.unwrap_or(u), approach.unwrap_or(n))
+            }
+        };
+        let (displacement, dissipation) = match new.traction.stick {
+            Some(_) => (new_ux - old_ux, step_dissipation(model, old, new)),
+            None => (0.0, 0.0),
+        };
         let electric_work = match (old.potential, new.potential) {
             (Some(a), Some(b)) => 0.5 * (a + b) * (new.charge - old.charge),
             _ => 0.0,
@@ -881,49 +897,30 @@ fn record(
     }
 }
 
-/// Increment of the punch displacement and the frictional dissipation between two states.
+/// The frictional dissipation between two states (zero when the new state has no stick zone).
 ///
-/// The punch moves rigidly, so on the new stick zone `Δux` is uniform and equals `Δδ`; it is
-/// taken at the material point `anchor` of the stick zone. The driver keeps one anchor for as
-/// long as it sticks, so that the increments telescope: δ is then `ux(anchor)` of the current
-/// state plus a constant, and a cycle that repeats its states repeats δ exactly (averaging
-/// over points that change from step to step leaves the discretisation error of `ux` to
-/// accumulate as a drift, measured at 2e−6 of the loop's δ range per cycle for the Figure-4
-/// history). In a slip zone the slip increment is
-/// `Δs(x) = ∫ from the stick end to x of Δε` (Δε the change of the surface strain), and the
-/// dissipated energy `−∫ q̄ Δs dx` (q̄ the mean of the two tractions, second order in the step)
-/// is evaluated after an integration by parts as `∓∫ Δε(t) T(t) dt`, with T the integral of q̄
-/// from t to the contact end, so that Δε is needed only at the quadrature nodes.
-///
-/// Returns `(Δδ, dissipation, ux_new(anchor))`; `old_ux` is `ux_old(anchor)` when already known
-/// (the previous step's `ux_new` at the same anchor), computed otherwise.
-pub fn step_increments(
-    model: &ContactModel,
-    old: &ContactState,
-    new: &ContactState,
-    anchor: f64,
-    old_ux: Option<f64>,
-) -> (f64, f64, f64) {
-    let new_ux = new.surface_displacement(model, anchor);
+/// In a slip zone the slip increment is `Δs(x) = ∫ from the stick end to x of Δε` (Δε the
+/// change of the surface strain), and the dissipated energy `−∫ q̄ Δs dx` (q̄ the mean of the
+/// two tractions, second order in the step) is evaluated after an integration by parts as
+/// `∓∫ Δε(t) T(t) dt`, with T the integral of q̄ from t to the contact end, so that Δε is
+/// needed only at the quadrature nodes.
+pub fn step_dissipation(model: &ContactModel, old: &ContactState, new: &ContactState) -> f64 {
     let Some(stick) = new.traction.stick.as_ref() else {
-        return (0.0, 0.0, new_ux);
+        return 0.0;
     };
-    let old_ux = old_ux.unwrap_or_else(|| old.surface_displacement(model, anchor));
-    let d_delta = new_ux - old_ux;
-    let q_mean = |xs: &[f64], out: &mut Vec<f64>| {
-        let mut before = Vec::new();
-        new.tractions_into(xs, out);
-        old.tractions_into(xs, &mut before);
-        for (q, old) in out.iter_mut().zip(before) {
-            *q = 0.5 * (old + *q);
-        }
-    };
-    // Δε at the nodes of a table.
-    let d_strain = |table: &crate::contact::GradedTable| -> Vec<f64> {
-        let at: Vec<f64> = table.nodes.iter().map(|n| n.0).collect();
-        let mut change = Vec::with_capacity(at.len());
-        new.strain_changes_into(model, old, &at, &mut change);
-        change
+    // q̄ onto `out` and Δε onto `changes` at each of xs, each state's pressure computed once
+    // for its traction and strain.
+    let mean_and_change = |xs: &[f64], out: &mut Vec<f64>, changes: &mut Vec<f64>| {
+        let fields = |state: &ContactState| {
+            let (mut p, mut q, mut strain) = (Vec::new(), Vec::new(), Vec::new());
+            state.pressures_into(xs, &mut p);
+            state.tractions_with(xs, &p, &mut q);
+            state.strains_with(model, xs, &p, &mut strain);
+            (q, strain)
+        };
+        let ((q_new, strain_new), (q_old, strain_old)) = (fields(new), fields(old));
+        out.extend(q_new.iter().zip(&q_old).map(|(n, o)| 0.5 * (o + n)));
+        changes.extend(strain_new.iter().zip(&strain_old).map(|(n, o)| n - o));
     };
     let left_end = (old.centre - old.half_width).min(new.centre - new.half_width);
     let right_end = (old.centre + old.half_width).max(new.centre + new.half_width);
@@ -947,24 +944,28 @@ pub fn step_increments(
             .collect();
         pts.extend([from, to]);
         let nodes = crate::contact::slip_zone_rule_nodes(new.pressure.beta.len());
-        crate::contact::graded_cumulative(pts, nodes, &q_mean)
+        let mut changes = Vec::new();
+        let table = crate::contact::graded_cumulative(pts, nodes, &mut |xs, out| {
+            mean_and_change(xs, out, &mut changes)
+        });
+        (table, changes)
     };
     // Right zone: −∫_{hi}^{R} Δε(t) ∫_t^R q̄; left zone: +∫_{L}^{lo} Δε(t) ∫_L^t q̄.
-    let right_table = table(stick.hi, right_end);
+    let (right_table, right_changes) = table(stick.hi, right_end);
     let right: f64 = right_table
         .nodes
         .iter()
-        .zip(d_strain(&right_table))
+        .zip(right_changes)
         .map(|(&(_, w, _, before), d)| w * d * (right_table.total - before))
         .sum();
-    let left_table = table(left_end, stick.lo);
+    let (left_table, left_changes) = table(left_end, stick.lo);
     let left: f64 = left_table
         .nodes
         .iter()
-        .zip(d_strain(&left_table))
+        .zip(left_changes)
         .map(|(&(_, w, _, before), d)| w * d * before)
         .sum();
-    (d_delta, -right + left, new_ux)
+    -right + left
 }
 
 /// A finished run: the records and the final driver state.

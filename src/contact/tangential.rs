@@ -1761,7 +1761,8 @@ pub fn assess_step(
     // `slip_zone_rule_nodes` per balanced piece give the slips to 1.2e−6 of the largest
     // (measured over the default history at M = 64 … 512 against four times the nodes), far
     // inside the check's tolerance of 1e−2.
-    let d_strain = |xs: &[f64], out: &mut Vec<f64>| new.strain_changes_into(model, old, xs, out);
+    let mut d_strain =
+        |xs: &[f64], out: &mut Vec<f64>| new.strain_changes_into(model, old, xs, out);
     let breaks = super::step_breakpoints(old, new);
     let mut slips = Vec::new();
     let zones = [
@@ -1790,7 +1791,7 @@ pub fn assess_step(
         pts.extend(&samples);
         pts.extend([left, right]);
         let nodes = super::slip_zone_rule_nodes(new.pressure.beta.len()) / 2;
-        let table = super::graded_cumulative(pts, nodes, &d_strain);
+        let table = super::graded_cumulative(pts, nodes, &mut d_strain);
         for x in samples {
             // ∫ from `left` to x: the nodes of the pieces before x (x is a piece end).
             let before: f64 = table
