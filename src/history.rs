@@ -695,13 +695,13 @@ pub fn solve_step(
     if new_phase && let Some(zone) = driver.state.traction.stick.as_ref() {
         // The turning state is about to be cloned into the memory and into the new phase's
         // base, and both are evaluated at every residual evaluation of the phase: tabulate its
-        // H'q̃ first, so that the clones share one table (`StickZone::tabulate_cauchy`; the
+        // H'q̃ and q̃ first, so that the clones share one table (`StickZone::tabulate`; the
         // normal-loading state comes tabulated, and earlier bases in the chain were tabulated
         // when their phases began). A zone accepted in the middle of a phase is evaluated only
         // by the next step's checks and increments, too few times to pay for a table (default
         // run: tabulating every accepted zone 1.81 s, the bases only 1.60 s, δ and the stick
         // ends the same to 1e−13 of themselves).
-        zone.tabulate_cauchy(disc.nodes() + 32);
+        zone.tabulate(disc.nodes() + 32);
     }
     let memory = if new_phase {
         match (&driver.phase_sign, driver.state.traction.stick.as_ref()) {

@@ -262,7 +262,7 @@ fn solve_normal_directed(
             // The state is evaluated many times from here on (checks, fields, memory).
             state.tabulate_shape();
             if let Some(zone) = state.traction.stick.as_ref() {
-                zone.tabulate_cauchy(disc.nodes() + 32);
+                zone.tabulate(disc.nodes() + 32);
             }
             let admissibility = check_normal_state(model, &state, slope_fin, options.admissibility)
                 .map_err(|failure| {

@@ -55,8 +55,8 @@
 //! where the new zone ends inside the old one), and solves only for the smooth remainder. In
 //! the uncoupled limit this reproduces Cattaneo–Mindlin–Deresiewicz–Masing histories to
 //! round-off. An accepted zone drops an own correction that is round-off; the zones a phase
-//! inherits from (its base chain) carry their `H'q̃` tabulated piecewise
-//! (`StickZone::tabulate_cauchy`); a zone that carries nothing of its own is skipped when a
+//! inherits from (its base chain) carry their `H'q̃` and q̃ tabulated piecewise
+//! (`StickZone::tabulate`); a zone that carries nothing of its own is skipped when a
 //! later zone inherits it, so a steady history's chains stop growing.
 //!
 //! # Kinks at the stick ends
