@@ -487,6 +487,17 @@ fn power_sum(c: &[f64], z: f64) -> f64 {
     c.iter().rev().fold(0.0, |acc, &cn| acc * z + cn)
 }
 
+/// [`power_sum`] at each of `L` points, their recurrences interleaved (bit-identical).
+fn power_sums<const L: usize>(c: &[f64], z: [f64; L]) -> [f64; L] {
+    let mut acc = [0.0; L];
+    for &cn in c.iter().rev() {
+        for l in 0..L {
+            acc[l] = acc[l] * z[l] + cn;
+        }
+    }
+    acc
+}
+
 /// `z = τ − sgn(τ)√(τ²−1)` for |τ| ≥ 1, the exterior Joukowski variable (|z| ≤ 1).
 fn exterior(tau: f64) -> f64 {
     tau - tau.signum() * (tau * tau - 1.0).max(0.0).sqrt()
@@ -578,12 +589,18 @@ impl BoundedSeries {
                 }
             }
         }
+        let outside = tau.iter().any(|t| t.abs() >= 1.0);
+        let z = tau.map(|t| if t.abs() < 1.0 { 0.0 } else { exterior(t) });
+        let powers = if outside {
+            power_sums(&self.beta, z)
+        } else {
+            [0.0; L]
+        };
         std::array::from_fn(|l| {
             if tau[l].abs() < 1.0 {
                 tau[l] * b1[l] - b2[l]
             } else {
-                let z = exterior(tau[l]);
-                -z * power_sum(&self.beta, z)
+                -z[l] * powers[l]
             }
         })
     }

@@ -905,18 +905,23 @@ impl StickZone {
             .unwrap_or_else(|| self.direct_cauchy(x))
     }
 
-    /// [`Self::correction_cauchy`] at each of `xs` into `out` (bit-identical; the chain's fade
-    /// integrals in batches, [`Inherited::cauchy_into`]).
+    /// [`Self::correction_cauchy`] at each of `xs` into `out` (bit-identical; the own series
+    /// four points at a time, [`BoundedSeries::cauchys`], and the chain's fade integrals in
+    /// batches, [`Inherited::cauchy_into`]).
     pub fn correction_cauchys_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         out.clear();
         if let Some(table) = self.cauchy_table.0.get() {
             table.values_into(xs, |x| self.direct_cauchy(x), out);
             return;
         }
-        out.extend(
-            xs.iter()
-                .map(|&x| self.own_part(x, BoundedSeries::cauchy, kink_cauchy)),
-        );
+        let (mid, half) = (self.mid(), self.half());
+        let own4 = |x: [f64; 4]| {
+            let u = x.map(|x| (x - mid) / half);
+            let series = (!self.correction.beta.is_empty()).then(|| self.correction.cauchys(u));
+            std::array::from_fn(|l| self.own_with(u[l], series.map(|s| s[l]), kink_cauchy))
+        };
+        let own = |x| self.own_part(x, BoundedSeries::cauchy, kink_cauchy);
+        in_fours(xs, own4, own, out);
         if let Some(link) = &self.inherited {
             let mut inner = Vec::with_capacity(xs.len());
             link.cauchy_into(xs, &mut inner);
