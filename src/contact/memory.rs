@@ -107,14 +107,41 @@ impl Memory {
 
     /// The remembered strain at x.
     pub fn strain(&self, model: &ContactModel, x: f64) -> f64 {
-        let piece = self
-            .pieces
-            .iter()
-            .find(|p| x <= p.hi)
-            .unwrap_or_else(|| self.pieces.last().expect("pieces"));
-        match piece.source.as_ref() {
+        match self.piece_at(x).source.as_ref() {
             StrainSource::Linear { slope } => slope * x.abs(),
             StrainSource::State { state } => state.strain_at(model, x),
+        }
+    }
+
+    /// The piece that holds x (the first whose right end is not below x).
+    fn piece_at(&self, x: f64) -> &Piece {
+        self.pieces
+            .iter()
+            .find(|p| x <= p.hi)
+            .unwrap_or_else(|| self.pieces.last().expect("pieces"))
+    }
+
+    /// [`Self::strain`] at each of `xs` into `out`, bit for bit: each run of consecutive points
+    /// in one piece in a batch ([`ContactState::strains_into`]).
+    pub fn strains_into(&self, model: &ContactModel, xs: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        let mut values = Vec::new();
+        let mut start = 0;
+        while start < xs.len() {
+            let piece = self.piece_at(xs[start]);
+            let run = xs[start..]
+                .iter()
+                .take_while(|&&x| std::ptr::eq(self.piece_at(x), piece))
+                .count();
+            let batch = &xs[start..start + run];
+            match piece.source.as_ref() {
+                StrainSource::Linear { slope } => out.extend(batch.iter().map(|x| slope * x.abs())),
+                StrainSource::State { state } => {
+                    state.strains_into(model, batch, &mut values);
+                    out.extend(&values);
+                }
+            }
+            start += run;
         }
     }
 

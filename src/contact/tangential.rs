@@ -354,18 +354,21 @@ impl StepProblem<'_> {
         };
         // Parts of the stick right-hand side that do not change in the inner iteration (with
         // no charge unknown, whatever charge the state carries is among them).
-        let mut chain_cauchy = Vec::with_capacity(m);
+        let (mut chain_cauchy, mut remembered) = (Vec::with_capacity(m), Vec::with_capacity(m));
         closed.correction_cauchys_into(&stick_points, &mut chain_cauchy);
+        self.memory
+            .strains_into(model, &stick_points, &mut remembered);
         let fixed: Vec<f64> = stick_points
             .iter()
             .zip(&chain_cauchy)
-            .map(|(&x, h)| {
+            .zip(&remembered)
+            .map(|((&x, h), strain)| {
                 let fixed_charge = if split.conducting {
                     0.0
                 } else {
                     w13 * guess.potential_charge_at(x) / y11
                 };
-                self.memory.strain(model, x) / y11 - h + fixed_charge
+                strain / y11 - h + fixed_charge
             })
             .collect();
         let inherited_force = closed.correction_integral();

@@ -1454,16 +1454,21 @@ fn surface_displacement_quadrature_scales_with_m() {
 /// one-point functions, on the states of a history through a reversal: first-loading states
 /// (the normal-loading zone faded at both ends), mixed-sign states after the reversal, and
 /// zones that inherit a turning state whole; at points inside and outside the contact, at the
-/// stick ends and the fade ramps' ends, in counts that are not multiples of four.
+/// stick ends and the fade ramps' ends, in counts that are not multiples of four. So does the
+/// remembered strain of each phase's memory (`Memory::strains_into`), across its pieces.
 #[test]
 fn batched_fields_equal_the_one_point_fields() {
     use fretsim::contact::ContactState;
+    use fretsim::contact::memory::Memory;
     use fretsim::contact::tangential::SlipOptions;
     use fretsim::history::{LoadHistory, Observer, StepRecord, run_history};
-    struct States(Vec<ContactState>);
+    struct States(Vec<ContactState>, Vec<Memory>);
     impl Observer for States {
         fn on_step(&mut self, _: &StepRecord, state: &ContactState) {
             self.0.push(state.clone());
+        }
+        fn on_phase(&mut self, _: usize, memory: &Memory) {
+            self.1.push(memory.clone());
         }
     }
     let b = baseline(32);
@@ -1472,7 +1477,7 @@ fn batched_fields_equal_the_one_point_fields() {
         steps_per_segment: 6,
         max_step: 0.1 * b.lim,
     };
-    let mut states = States(Vec::new());
+    let mut states = States(Vec::new(), Vec::new());
     run_history(
         &b.model,
         &b.disc,
@@ -1482,6 +1487,23 @@ fn batched_fields_equal_the_one_point_fields() {
         &mut states,
     )
     .unwrap();
+    assert_eq!(states.1.len(), 2, "one memory per phase");
+    let a = b.normal.state.half_width;
+    for memory in &states.1 {
+        // Runs of points in one piece, in both directions, and every piece end.
+        let mut xs: Vec<f64> = (0..=97)
+            .map(|i| -1.2 * a + 2.4 * a * f64::from(i) / 97.0)
+            .collect();
+        xs.extend((0..=40).map(|i| 1.1 * a - 2.2 * a * f64::from(i) / 40.0));
+        xs.extend(memory.breakpoints());
+        let mut batch = Vec::new();
+        memory.strains_into(&b.model, &xs, &mut batch);
+        assert_eq!(batch.len(), xs.len());
+        for (v, &x) in batch.iter().zip(&xs) {
+            let one = memory.strain(&b.model, x);
+            assert_eq!(v.to_bits(), one.to_bits(), "remembered strain at {x}");
+        }
+    }
     let (mut mixed, mut faded, mut whole) = (0, 0, 0);
     for s in &states.0 {
         let Some(zone) = s.traction.stick.as_ref() else {
