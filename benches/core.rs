@@ -91,21 +91,21 @@ fn bench_step(c: &mut Criterion, name: &str, sizes: &[usize], loads: &[f64], nex
     g.finish();
 }
 
-fn steps(c: &mut Criterion) {
-    // In the middle of the first forward phase.
-    bench_step(c, "solve/forward_step", &SIZES, &[0.1, 0.2, 0.3], 0.35);
-    // The same step without its increments (δ, dissipation, δn), which `run_history`
-    // computes on a second thread while it solves the next step.
+/// Time the state of one step to `next` ηP from the state after `loads`, without the
+/// increments (δ, dissipation, δn), which `run_history` computes on a second thread while it
+/// solves the next step.
+fn bench_state(c: &mut Criterion, name: &str, sizes: &[usize], loads: &[f64], next: f64) {
     let sc = default_scenario();
-    let mut g = c.benchmark_group("solve/forward_step_state_only");
+    let mut g = c.benchmark_group(name);
     g.sample_size(10);
-    for m in SIZES {
+    for &m in sizes {
         let disc = Discretisation::new(m);
-        let driver = driver_after(&sc, &disc, &[0.1, 0.2, 0.3]);
+        let driver = driver_after(&sc, &disc, loads);
+        let n = loads.len() + 1;
         let point = LoadPoint {
-            step: 4,
-            t: 4.0,
-            q: 0.35 * sc.model.friction * sc.normal_load,
+            step: n,
+            t: n as f64,
+            q: next * sc.model.friction * sc.normal_load,
         };
         g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
             b.iter(|| {
@@ -119,6 +119,13 @@ fn steps(c: &mut Criterion) {
     g.finish();
 }
 
+fn steps(c: &mut Criterion) {
+    // In the middle of the first forward phase.
+    let loads = [0.1, 0.2, 0.3];
+    bench_step(c, "solve/forward_step", &SIZES, &loads, 0.35);
+    bench_state(c, "solve/forward_step_state_only", &SIZES, &loads, 0.35);
+}
+
 fn recalled(c: &mut Criterion) {
     // The same step, 0.30 → 0.35 ηP, in the third forward phase of the default history: that
     // phase began from the same turning state (−½ ηP) as the second, whose step at 0.35 ηP
@@ -127,6 +134,13 @@ fn recalled(c: &mut Criterion) {
     loads.extend((1..=20).map(|i| 0.5 - 0.05 * i as f64));
     loads.extend((1..=16).map(|i| -0.5 + 0.05 * i as f64));
     bench_step(c, "solve/recalled_forward_step", &SIZES, &loads, 0.35);
+    bench_state(
+        c,
+        "solve/recalled_forward_step_state_only",
+        &SIZES,
+        &loads,
+        0.35,
+    );
 }
 
 fn reversal(c: &mut Criterion) {
