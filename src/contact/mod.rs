@@ -269,14 +269,14 @@ pub struct StickZone {
 /// (`StickZone::chain_kinks`), for a zone with a chain: one sum of `M + 32` terms instead of
 /// one of M terms for every zone of the chain (in a steady cycle, four).
 #[derive(Debug, Clone, Default)]
-struct CauchyTable {
+struct ChainTable {
     /// Piece ends, increasing.
     ends: Vec<f64>,
     /// Chebyshev coefficients in v, one series per piece.
     coefficients: Vec<Vec<f64>>,
 }
 
-impl CauchyTable {
+impl ChainTable {
     /// The table of f on the pieces between `ends`, `nodes` Chebyshev points per piece in the
     /// graded variable.
     fn interpolating(ends: Vec<f64>, nodes: usize, f: impl Fn(f64) -> f64) -> Self {
@@ -367,7 +367,7 @@ impl CauchyTable {
 
 /// A cache filled at most once that takes no part in comparisons.
 #[derive(Debug, Clone, Default)]
-struct TableCache(std::sync::OnceLock<CauchyTable>);
+struct TableCache(std::sync::OnceLock<ChainTable>);
 
 impl PartialEq for TableCache {
     fn eq(&self, _: &Self) -> bool {
@@ -735,6 +735,14 @@ const FADE_POINTS: f64 = 6.0;
 
 /// `f` at each of `xs` into `out`, four points at a time by `f4`, which must give `f`'s values
 /// bit for bit (the four-point Chebyshev sums of [`crate::quadrature`]).
+/// A zone's own part in one form (density or Cauchy transform): the series at four points,
+/// at one point, and the kink term ([`StickZone::own_parts_into`]).
+type OwnForms = (
+    fn(&BoundedSeries, [f64; 4]) -> [f64; 4],
+    fn(&BoundedSeries, f64) -> f64,
+    fn(f64) -> f64,
+);
+
 fn in_fours(
     xs: &[f64],
     f4: impl Fn([f64; 4]) -> [f64; 4],
@@ -772,7 +780,7 @@ impl StickZone {
         sign_blend(self.end_signs, self.lo, self.hi, x)
     }
 
-    /// Tabulate `H'q̃` and q̃ (see `CauchyTable`) for a zone that will be evaluated many times
+    /// Tabulate `H'q̃` and q̃ (see `ChainTable`) for a zone that will be evaluated many times
     /// (one that a phase inherits from), with `nodes` Chebyshev points per piece. No-op if
     /// already done.
     pub fn tabulate(&self, nodes: usize) {
@@ -783,7 +791,7 @@ impl StickZone {
         self.cauchy_table.0.get_or_init(|| {
             let mut points = vec![self.lo - width, self.lo, self.hi, self.hi + width];
             points.extend(&inner);
-            CauchyTable::interpolating(piece_ends(points), nodes, |x| self.direct_cauchy(x))
+            ChainTable::interpolating(piece_ends(points), nodes, |x| self.direct_cauchy(x))
         });
         // A zone without a chain sums its own series faster than a table of more terms.
         if self.inherited.is_none() {
@@ -793,7 +801,7 @@ impl StickZone {
             let mut points = vec![self.lo, self.hi];
             points.extend(&inner);
             let smooth = |x| self.direct_correction(x) - self.chain_kinks(x);
-            CauchyTable::interpolating(piece_ends(points), nodes, smooth)
+            ChainTable::interpolating(piece_ends(points), nodes, smooth)
         });
     }
 
@@ -854,14 +862,8 @@ impl StickZone {
             }
             return;
         }
-        let (mid, half) = (self.mid(), self.half());
-        let own4 = |x: [f64; 4]| {
-            let u = x.map(|x| (x - mid) / half);
-            let series = (!self.correction.beta.is_empty()).then(|| self.correction.densities(u));
-            std::array::from_fn(|l| self.own_with(u[l], series.map(|s| s[l]), kink_density))
-        };
-        let own = |x| self.own_part(x, BoundedSeries::density, kink_density);
-        in_fours(xs, own4, own, out);
+        let four = BoundedSeries::densities::<4>;
+        self.own_parts_into(xs, (four, BoundedSeries::density, kink_density), out);
         if let Some(link) = &self.inherited {
             let mut inner = Vec::with_capacity(xs.len());
             link.values_into(xs, &mut inner);
@@ -876,6 +878,18 @@ impl StickZone {
                 0.0
             };
         }
+    }
+
+    /// [`Self::own_part`] at each of `xs` into `out` (bit-identical: the series four points at
+    /// a time by `four`, the rest by `one`; the kink term through `kink`).
+    fn own_parts_into(&self, xs: &[f64], (four, one, kink): OwnForms, out: &mut Vec<f64>) {
+        let (mid, half) = (self.mid(), self.half());
+        let own4 = |x: [f64; 4]| {
+            let u = x.map(|x| (x - mid) / half);
+            let series = (!self.correction.beta.is_empty()).then(|| four(&self.correction, u));
+            std::array::from_fn(|l| self.own_with(u[l], series.map(|s| s[l]), kink))
+        };
+        in_fours(xs, own4, |x| self.own_part(x, one, kink), out);
     }
 
     /// [`Self::own_part`] at u from the series' term there (`None` when the zone has no
@@ -914,14 +928,8 @@ impl StickZone {
             table.values_into(xs, |x| self.direct_cauchy(x), out);
             return;
         }
-        let (mid, half) = (self.mid(), self.half());
-        let own4 = |x: [f64; 4]| {
-            let u = x.map(|x| (x - mid) / half);
-            let series = (!self.correction.beta.is_empty()).then(|| self.correction.cauchys(u));
-            std::array::from_fn(|l| self.own_with(u[l], series.map(|s| s[l]), kink_cauchy))
-        };
-        let own = |x| self.own_part(x, BoundedSeries::cauchy, kink_cauchy);
-        in_fours(xs, own4, own, out);
+        let four = BoundedSeries::cauchys::<4>;
+        self.own_parts_into(xs, (four, BoundedSeries::cauchy, kink_cauchy), out);
         if let Some(link) = &self.inherited {
             let mut inner = Vec::with_capacity(xs.len());
             link.cauchy_into(xs, &mut inner);
