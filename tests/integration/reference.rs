@@ -1378,6 +1378,81 @@ fn recalled_cycles_repeat_the_solved_ones() {
     assert!(dissipation < 1e-11, "{dissipation:e}");
 }
 
+/// A step that reproduces a recalled step from the state that one began from takes that
+/// step's increments instead of computing them (`SolvedStep::known_increments`). Through
+/// nine phases of the default history (four ±½ ηP cycles after the first loading) at M = 32
+/// and 64, every step whose increments are known is checked against computing them. Phases
+/// 5–9 recall phases 3–7 whole: the turning state at −½ ηP that begins phase 5 is the Masing
+/// return to the one that began phase 3, at its geometry to the bit, so from step 71 on every
+/// step is known. Measured: Δδ, the dissipation and the anchor's ux agree to 2.8e−14 of the
+/// largest of each, δn and the work of P to 3.9e−16 of the largest P δn (the work is a
+/// difference of two δn); the bound is 1e−12. Which differences of the two states or the
+/// anchor stop a step taking the increments is tested in the history module.
+#[test]
+fn known_increments_are_the_computed_ones() {
+    use fretsim::contact::tangential::SlipOptions;
+    use fretsim::history::{
+        DriverState, LoadHistory, LoadPoint, NoObserver, Solved, StepIncrements, finish_step,
+        solve_step,
+    };
+    for m in [32, 64] {
+        let b = baseline(m);
+        let history = LoadHistory {
+            points: half_amplitude_cycles(b.lim, 9),
+            steps_per_segment: 10,
+            max_step: 0.05 * b.lim,
+        };
+        let mut driver = DriverState::after_normal_loading(&b.normal);
+        let mut pairs = Vec::new();
+        for (i, (_, t, q)) in history.steps().into_iter().enumerate() {
+            let point = LoadPoint { step: i + 1, t, q };
+            let options = SlipOptions::default();
+            let Ok(Solved::Slip(solved)) =
+                solve_step(&b.model, &b.disc, &mut driver, point, options)
+            else {
+                panic!("M = {m}: step {} is a slip step", i + 1);
+            };
+            let computed = StepIncrements::compute(&b.model, &solved.increment_inputs(&driver));
+            let known = solved.known_increments();
+            if let Some(k) = known {
+                pairs.push((i + 1, k, computed));
+            }
+            finish_step(
+                &mut driver,
+                *solved,
+                known.unwrap_or(computed),
+                &mut NoObserver,
+            );
+        }
+        // Phases 1-4 (steps 1-70) are solved afresh; phases 5-9 recall phases 3-7.
+        let steps: Vec<usize> = pairs.iter().map(|p| p.0).collect();
+        assert_eq!(steps, (71..=170).collect::<Vec<_>>(), "M = {m}");
+        // Each field against the largest of a scale field over the run, times a factor: the
+        // work of P against P δn, whose round-off its difference of two δn carries.
+        type Field = fn(&StepIncrements) -> f64;
+        let load = b.normal.state.normal_load;
+        let fields: [(&str, Field, Field, f64); 5] = [
+            ("Δδ", |x| x.displacement, |x| x.displacement, 1.0),
+            ("dissipation", |x| x.dissipation, |x| x.dissipation, 1.0),
+            ("work of P", |x| x.normal_work, |x| x.new_approach, load),
+            ("ux at the anchor", |x| x.new_ux, |x| x.new_ux, 1.0),
+            ("δn", |x| x.new_approach, |x| x.new_approach, 1.0),
+        ];
+        for (name, field, scale_field, factor) in fields {
+            let scale = factor
+                * pairs
+                    .iter()
+                    .map(|(.., c)| scale_field(c).abs())
+                    .fold(0.0, f64::max);
+            assert!(scale > 0.0, "{name}");
+            for (step, k, c) in &pairs {
+                let error = (field(k) - field(c)).abs() / scale;
+                assert!(error < 1e-12, "M = {m}, step {step}, {name}: {error:e}");
+            }
+        }
+    }
+}
+
 /// The tangential surface displacement at a point of the stick zone (the anchor of δ) at
 /// M = 256, where the traction's series has 256 terms, against an independent quadrature: the
 /// contact split at every breakpoint of the traction and at x, each piece by an 800-node
