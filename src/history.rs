@@ -42,14 +42,15 @@
 //! its residual exceeds the recall limit, and the step is solved as above
 //! (`SlipOptions::recall`; measured in `docs/performance.md`, ninth session).
 //!
-//! A step's increments are a function of its two states and the anchor. When a step is
-//! accepted at the recalled state's geometry and slip signs to the bit (its first evaluation
-//! solved it), from a state whose geometry and signs are to the bit those of the state the
-//! recalled step began from, and δ is followed at the same anchor, the two states are the
-//! recalled step's to the solver's tolerance, and the step takes that step's increments
-//! ([`SolvedStep::known_increments`]) instead of computing them (measured: within 2.8e−14 of
-//! the computed ones, test `known_increments_are_the_computed_ones`). In a steady cycle every
-//! step does.
+//! A step's checks, φ0 and increments are functions of its two states (and the anchor, for
+//! δ). When a step begins from a state whose geometry and slip signs are to the bit those of
+//! the state the recalled step began from, and is accepted at the recalled geometry (its first
+//! evaluation solved it), its two states are the recalled step's to the solver's tolerance:
+//! it takes that step's checks and φ0 ([`Recalled::admissibility`]) and, when δ is followed
+//! at the same anchor, its increments ([`SolvedStep::known_increments`]) instead of
+//! evaluating them (measured: within 2.8e−14 of evaluating them, test
+//! `repeated_steps_take_the_checks_and_increments_they_would_compute`). In a steady cycle
+//! every step does: the step is one residual evaluation.
 
 use std::sync::{Arc, OnceLock};
 
@@ -365,8 +366,13 @@ impl TracedIncrements {
     /// known.
     fn for_step(&self, from: Footprint, at: Footprint, anchor: f64) -> Option<StepIncrements> {
         let (taken_at, increments) = self.value.get()?;
-        (self.from == from && self.at == at && taken_at.to_bits() == anchor.to_bits())
+        (self.began_from(from) && self.at == at && taken_at.to_bits() == anchor.to_bits())
             .then_some(*increments)
+    }
+
+    /// Whether the traced step began from a state of footprint `from`.
+    fn began_from(&self, from: Footprint) -> bool {
+        self.from == from
     }
 }
 
@@ -839,7 +845,15 @@ pub fn solve_step(
         .filter(|_| options.recall)
         .and_then(|start| driver.traces.recall(&start, sign, q, limit))
         .cloned();
-    let recalled = traced.as_ref().map(|t| &t.recalled);
+    // The recalled step's checks go with it when this step begins from its start.
+    let from = footprint(&driver.state);
+    let recalled = traced.as_ref().map(|t| Recalled {
+        admissibility: t
+            .recalled
+            .admissibility
+            .filter(|_| t.increments.began_from(from)),
+        ..t.recalled.clone()
+    });
     let solved: SlipStep = solve_slip(
         model,
         disc,
@@ -855,7 +869,7 @@ pub fn solve_step(
         } else {
             driver.warm.as_ref()
         },
-        recalled,
+        recalled.as_ref(),
         options,
     )
     .map_err(|failure| StepFailure {
@@ -900,7 +914,7 @@ pub fn solve_step(
         ),
         jacobian: solved.jacobian,
     });
-    let (from, at) = (footprint(&driver.state), footprint(&solved.state));
+    let at = footprint(&solved.state);
     // A step that reproduced the recalled one from the state that one began from, with the
     // same anchor, has its increments (module docs, "Recall of a repeated phase").
     let known = traced.and_then(|t| t.increments.for_step(from, at, driver.anchor));
@@ -921,6 +935,7 @@ pub fn solve_step(
         recalled: Recalled {
             state: Arc::clone(&new),
             warm: driver.warm.expect("set above"),
+            admissibility: Some(solved.admissibility),
         },
         increments: TracedIncrements {
             from,

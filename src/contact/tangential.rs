@@ -41,7 +41,10 @@
 //! A step may be started from a recalled earlier step instead ([`Recalled`]: the same load in
 //! a phase of the same direction that began from the same turning state). It is continued
 //! only when its first residual, solved at the full inner tolerance, is below
-//! `RECALL_RESIDUAL`; it is accepted by the same tolerance and checks as any other step.
+//! `RECALL_RESIDUAL`; it is accepted by the same tolerance and checks as any other step,
+//! except that a step accepted at the recalled geometry to the bit from the recalled step's
+//! start state takes that step's checks and φ0 (`Recalled::admissibility`): its states are
+//! the recalled step's to the tolerance.
 //! An attempt that stalls from a carried Jacobian is made once more from a finite-difference
 //! one before its stalled iterate is taken.
 //! (Block Gauss–Seidel between the stick ends and (a, c), as in the seed paper, falls into
@@ -1164,6 +1167,25 @@ pub struct Recalled {
     pub state: Arc<ContactState>,
     /// Its slip signs and Jacobian.
     pub warm: WarmStart,
+    /// Its admissibility, when this step begins from the state the earlier one began from
+    /// (the caller's judgement; the driver's is that their geometries and slip signs agree to
+    /// the bit). A step accepted at the recalled geometry is then the earlier step again, to
+    /// the solver's tolerance: it takes these checks and the recalled state's charge and
+    /// potential instead of evaluating them.
+    pub admissibility: Option<StepAdmissibility>,
+}
+
+impl Recalled {
+    /// The recalled admissibility, when geometry `g` is the recalled state's to the bit.
+    fn repeated_at(&self, g: &Geometry) -> Option<StepAdmissibility> {
+        let s = &self.state;
+        let zone = s.traction.stick.as_ref()?;
+        let same = [g.lo, g.hi, g.a, g.c]
+            .iter()
+            .zip([zone.lo, zone.hi, s.half_width, s.centre])
+            .all(|(x, y)| x.to_bits() == y.to_bits());
+        self.admissibility.filter(|_| same)
+    }
 }
 
 /// Solve one step at tangential load `tangential_load` with slip sign `sign`, starting from
@@ -1333,7 +1355,7 @@ fn recall<'a>(
     let zone = state.traction.stick.as_ref()?;
     let guess = ((zone.lo, zone.hi), Some((state.half_width, state.centre)));
     let problem = problem_for(recalled.warm.signs);
-    let method = Method::Recall(recalled.warm.jacobian);
+    let method = Method::Recall(recalled);
     solve_geometry(&problem, start, state, guess, method, options).ok()
 }
 
@@ -1464,7 +1486,7 @@ impl Attempts {
 
 /// How the geometry is iterated.
 #[derive(Debug, Clone, Copy)]
-enum Method {
+enum Method<'a> {
     /// Broyden's updates from the given Jacobian (or a finite-difference one), within the
     /// evaluation budget.
     Broyden(Option<[[f64; 4]; 4]>),
@@ -1474,7 +1496,7 @@ enum Method {
     /// Broyden's updates from a recalled step's Jacobian, the first residual solved at the full
     /// inner tolerance (from the recalled coefficients, a pass or two), and given up at once
     /// when that residual exceeds [`RECALL_RESIDUAL`].
-    Recall([[f64; 4]; 4]),
+    Recall(&'a Recalled),
 }
 
 /// Newton's method on the geometry with Broyden's rank-one updates: the Jacobian is taken
@@ -1489,13 +1511,18 @@ fn solve_geometry(
     start: &ContactState,
     from: &ContactState,
     (guess, contact): ((f64, f64), Option<(f64, f64)>),
-    method: Method,
+    method: Method<'_>,
     options: SlipOptions,
 ) -> Result<SlipStep, Failed> {
     let (hint, broyden) = match method {
         Method::Broyden(hint) => (hint, true),
-        Method::Recall(jac) => (Some(jac), true),
+        Method::Recall(recalled) => (Some(recalled.warm.jacobian), true),
         Method::Newton => (None, false),
+    };
+    // The recalled step's checks, at an iterate that is its geometry (`Recalled`).
+    let repeated = |g: &Geometry| match method {
+        Method::Recall(recalled) => recalled.repeated_at(g),
+        _ => None,
     };
     let model = problem.model;
     let (a0, c0) = contact.unwrap_or((from.half_width, from.centre));
@@ -1536,25 +1563,32 @@ fn solve_geometry(
     let mut evaluations = 1;
     let mut jac = hint;
     let mut fresh = false;
-    // The state at an accepted iterate: φ0, the shape table and the checks.
+    // The state at an accepted iterate `g`: φ0, the shape table and the checks.
     let accept = |mut state: ContactState,
-                  a: f64,
+                  g: &Geometry,
                   iterations: usize,
                   evaluations: usize,
                   residual: f64,
                   jac: Option<[[f64; 4]; 4]>|
      -> Result<SlipStep, SolveFailure> {
+        let repeated = repeated(g);
         if state.split.conducting
             && !matches!(
                 model.electrode,
                 super::Electrode::ConductingPotential { .. }
             )
         {
-            // φ0 of the accepted state (charge control; the moment does not feed back).
-            let j_q = arcsine_moment(&state);
-            let (charge, potential) = electric_resultants(model, a, problem.normal_load, j_q);
-            state.charge = charge;
-            state.potential = potential;
+            // φ0 of the accepted state (charge control; the moment does not feed back), or
+            // the recalled state's when this is that state again.
+            (state.charge, state.potential) = match (repeated, method) {
+                (Some(_), Method::Recall(recalled)) => {
+                    (recalled.state.charge, recalled.state.potential)
+                }
+                _ => {
+                    let j_q = arcsine_moment(&state);
+                    electric_resultants(model, g.a, problem.normal_load, j_q)
+                }
+            };
         }
         // The accepted state is evaluated many times from here on (checks, increments,
         // memory): tabulate its shape quadrature once, and drop an own correction that is
@@ -1563,7 +1597,7 @@ fn solve_geometry(
         // every later evaluation of every state whose chain holds it, one more per cycle).
         state.tabulate_shape();
         state.drop_negligible_correction(model.friction);
-        let admissibility = assess_step(model, start, &state);
+        let admissibility = repeated.unwrap_or_else(|| assess_step(model, start, &state));
         check(&admissibility, options.admissibility)?;
         Ok(SlipStep {
             state,
@@ -1586,7 +1620,7 @@ fn solve_geometry(
             continue;
         }
         if size < options.tolerance {
-            return Ok(accept(state, g.a, iter, evaluations, size, jac)?);
+            return Ok(accept(state, &g, iter, evaluations, size, jac)?);
         }
         // Newton's fallback gets a larger budget: it needs 5 evaluations per iteration. An
         // attempt that is already within 1e4 of the tolerance is converging (attempts without
@@ -1669,7 +1703,7 @@ fn solve_geometry(
         size = norm(&r);
     }
     let stalled = (size < options.stall_tolerance)
-        .then(|| accept(state, g.a, iterations, evaluations, size, jac).ok())
+        .then(|| accept(state, &g, iterations, evaluations, size, jac).ok())
         .flatten()
         .map(Box::new);
     Err(Failed {
@@ -1829,6 +1863,62 @@ pub fn assess_step(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A recalled step's checks are taken only at its geometry to the bit, and only when the
+    /// caller gave them (the step begins from the recalled step's start).
+    #[test]
+    fn recalled_checks_need_the_recalled_geometry() {
+        use crate::contact::normal::{NormalOptions, solve_normal};
+        let sc = crate::scenario::default_scenario();
+        let disc = Discretisation::new(16);
+        let normal =
+            solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
+        let state = Arc::new(normal.state);
+        let zone = state
+            .traction
+            .stick
+            .as_ref()
+            .expect("frictional normal loading");
+        let g = Geometry {
+            lo: zone.lo,
+            hi: zone.hi,
+            a: state.half_width,
+            c: state.centre,
+        };
+        let checks = StepAdmissibility {
+            stick_excess: -0.25,
+            ..StepAdmissibility::default()
+        };
+        let recalled = Recalled {
+            state: Arc::clone(&state),
+            warm: WarmStart {
+                signs: (1.0, 1.0),
+                jacobian: [[0.0; 4]; 4],
+            },
+            admissibility: Some(checks),
+        };
+        assert_eq!(recalled.repeated_at(&g), Some(checks));
+        let next = |x: f64| f64::from_bits(x.to_bits() + 1);
+        for moved in [
+            Geometry {
+                lo: next(g.lo),
+                ..g
+            },
+            Geometry {
+                hi: next(g.hi),
+                ..g
+            },
+            Geometry { a: next(g.a), ..g },
+            Geometry { c: next(g.c), ..g },
+        ] {
+            assert!(recalled.repeated_at(&moved).is_none());
+        }
+        let elsewhere = Recalled {
+            admissibility: None,
+            ..recalled
+        };
+        assert!(elsewhere.repeated_at(&g).is_none());
+    }
 
     /// `solve_small` on every size up to `SMALL`: a system with a known solution whose first
     /// pivot is zero (so rows must be swapped) is solved to round-off, and a singular one is

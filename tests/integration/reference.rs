@@ -1379,18 +1379,22 @@ fn recalled_cycles_repeat_the_solved_ones() {
 }
 
 /// A step that reproduces a recalled step from the state that one began from takes that
-/// step's increments instead of computing them (`SolvedStep::known_increments`). Through
-/// nine phases of the default history (four ±½ ηP cycles after the first loading) at M = 32
-/// and 64, every step whose increments are known is checked against computing them. Phases
-/// 5–9 recall phases 3–7 whole: the turning state at −½ ηP that begins phase 5 is the Masing
-/// return to the one that began phase 3, at its geometry to the bit, so from step 71 on every
-/// step is known. Measured: Δδ, the dissipation and the anchor's ux agree to 2.8e−14 of the
-/// largest of each, δn and the work of P to 3.9e−16 of the largest P δn (the work is a
-/// difference of two δn); the bound is 1e−12. Which differences of the two states or the
-/// anchor stop a step taking the increments is tested in the history module.
+/// step's checks, φ0 and increments instead of evaluating them (`Recalled::admissibility`,
+/// `SolvedStep::known_increments`). Through nine phases of the default history (four ±½ ηP
+/// cycles after the first loading) at M = 32 and 64, every step whose increments are known is
+/// checked against evaluating them. Phases 5–9 recall phases 3–7 whole: the turning state at
+/// −½ ηP that begins phase 5 is the Masing return to the one that began phase 3, at its
+/// geometry to the bit, so from step 71 on every step is known. Measured: Δδ, the dissipation
+/// and the anchor's ux agree to 2.8e−14 of the largest of each, δn and the work of P to
+/// 3.9e−16 of the largest P δn (the work is a difference of two δn), the three admissibility
+/// measures to 3.1e−16 and φ0 to 2.1e−16 of itself; the bound is 1e−12. Which differences of
+/// the two states or the anchor stop a step taking the increments is tested in the history
+/// module.
 #[test]
-fn known_increments_are_the_computed_ones() {
-    use fretsim::contact::tangential::SlipOptions;
+fn repeated_steps_take_the_checks_and_increments_they_would_compute() {
+    use fretsim::contact::normal::arcsine_moment;
+    use fretsim::contact::pressure::electric_resultants;
+    use fretsim::contact::tangential::{SlipOptions, assess_step};
     use fretsim::history::{
         DriverState, LoadHistory, LoadPoint, NoObserver, Solved, StepIncrements, finish_step,
         solve_step,
@@ -1412,17 +1416,37 @@ fn known_increments_are_the_computed_ones() {
             else {
                 panic!("M = {m}: step {} is a slip step", i + 1);
             };
-            let computed = StepIncrements::compute(&b.model, &solved.increment_inputs(&driver));
+            let inputs = solved.increment_inputs(&driver);
+            let computed = StepIncrements::compute(&b.model, &inputs);
             let known = solved.known_increments();
-            if let Some(k) = known {
-                pairs.push((i + 1, k, computed));
-            }
-            finish_step(
+            let record = finish_step(
                 &mut driver,
                 *solved,
                 known.unwrap_or(computed),
                 &mut NoObserver,
             );
+            if let Some(k) = known {
+                pairs.push((i + 1, k, computed));
+                // The checks and φ0 the step took with the recalled state, against
+                // evaluating them.
+                let checks = assess_step(&b.model, &inputs.old, &inputs.new);
+                let (got, want) = (record.admissibility, checks);
+                for (name, x, y) in [
+                    ("stick excess", got.stick_excess, want.stick_excess),
+                    ("slip reversal", got.slip_reversal, want.slip_reversal),
+                    ("least pressure", got.min_pressure, want.min_pressure),
+                ] {
+                    let error = (x - y).abs();
+                    assert!(error < 1e-12, "M = {m}, step {}, {name}: {error:e}", i + 1);
+                }
+                let new = &inputs.new;
+                let j_q = arcsine_moment(new);
+                let (_, potential) =
+                    electric_resultants(&b.model, new.half_width, new.normal_load, j_q);
+                let (x, y) = (new.potential.unwrap(), potential.unwrap());
+                let error = (x - y).abs() / y.abs();
+                assert!(error < 1e-12, "M = {m}, step {}, φ0: {error:e}", i + 1);
+            }
         }
         // Phases 1-4 (steps 1-70) are solved afresh; phases 5-9 recall phases 3-7.
         let steps: Vec<usize> = pairs.iter().map(|p| p.0).collect();
