@@ -217,6 +217,30 @@ fn steady_cycle(c: &mut Criterion) {
     g.finish();
 }
 
+fn repeated_cycle(c: &mut Criterion) {
+    // The default history's third cycle (40 steps, +½ → −½ → +½ ηP), whose phases each begin
+    // from the turning state that began the same phase of the second cycle: every step is
+    // recalled, with its checks and increments.
+    let sc = default_scenario();
+    let mut g = c.benchmark_group("cycle/repeated_cycle");
+    g.sample_size(10);
+    for m in SIZES {
+        let disc = Discretisation::new(m);
+        let before = default_loads(2);
+        let driver = driver_after(&sc, &disc, &before);
+        let cycle = &default_loads(3)[before.len()..];
+        g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
+            b.iter(|| {
+                let mut d = driver.clone();
+                for (k, f) in cycle.iter().enumerate() {
+                    black_box(step(&sc, &disc, &mut d, before.len() + k + 1, *f));
+                }
+            })
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
     kernels,
@@ -225,6 +249,7 @@ criterion_group!(
     recalled,
     reversal,
     cycle,
-    steady_cycle
+    steady_cycle,
+    repeated_cycle
 );
 criterion_main!(benches);
