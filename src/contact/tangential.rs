@@ -477,10 +477,9 @@ impl StepProblem<'_> {
                 })
                 .collect()
         } else {
-            sample_points
-                .iter()
-                .map(|&x| guess.traction_at(x))
-                .collect()
+            let mut x = Vec::with_capacity(sample_points.len() + 2);
+            guess.tractions_into(&sample_points, &mut x);
+            x
         };
         if coupled {
             x.extend(guess_zone.map_or([0.0; 2], |z| probes.scaled_roots(|x| z.correction_at(x))));
@@ -1019,6 +1018,29 @@ impl InnerMaps {
     }
 }
 
+thread_local! {
+    /// The [`InnerMaps`] of this thread's last step, whose matrices the next step refills
+    /// (every evaluation writes all of them). Allocated afresh at every step, they were
+    /// mapped and zeroed page by page: about half of a recalled step at M = 512, whose
+    /// matrices hold 10 MB.
+    static INNER_MAPS: RefCell<InnerMaps> = RefCell::default();
+}
+
+/// This thread's [`InnerMaps`], lent to one step and given back when the step ends.
+struct LentMaps(RefCell<InnerMaps>);
+
+impl LentMaps {
+    fn lend() -> Self {
+        Self(RefCell::new(INNER_MAPS.take()))
+    }
+}
+
+impl Drop for LentMaps {
+    fn drop(&mut self) {
+        INNER_MAPS.set(self.0.take());
+    }
+}
+
 /// Anderson acceleration (type II) of a fixed-point iteration `x ← F(x)`: the next iterate
 /// combines the last `depth` values of F so that the combined residual `F(x) − x` is least
 /// squares. For the affine map of the inner iteration it converges in a few steps where the
@@ -1277,7 +1299,7 @@ pub fn solve_slip(
         }
     }
     let mut attempts = Attempts::default();
-    let scratch = RefCell::default();
+    let scratch = LentMaps::lend();
     let problem_for = |signs: (f64, f64)| StepProblem {
         model,
         disc,
@@ -1286,7 +1308,7 @@ pub fn solve_slip(
         signs,
         normal_load: start.normal_load,
         tangential_load,
-        scratch: &scratch,
+        scratch: &scratch.0,
     };
     if let Some(step) = recalled.and_then(|r| recall(&problem_for, start, r, options)) {
         return Ok(step);
