@@ -379,7 +379,7 @@ impl TracedIncrements {
 /// The bits of a state's stick ends, contact half-width and centre, and slip signs. A
 /// recalled step that is accepted at the recalled geometry (its first evaluation solves it
 /// to the tolerance, as in a steady cycle) has the recalled state's footprint; one that had
-/// to iterate has moved by at least its convergence tolerance and has not.
+/// to iterate has moved off it.
 type Footprint = [u64; 6];
 
 fn footprint(state: &ContactState) -> Footprint {

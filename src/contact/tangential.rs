@@ -1541,9 +1541,9 @@ fn solve_geometry(
         Method::Recall(recalled) => (Some(recalled.warm.jacobian), true),
         Method::Newton => (None, false),
     };
-    // The recalled step's checks, at an iterate that is its geometry (`Recalled`).
+    // The recalled step and its checks, at an iterate that repeats it (`Recalled`).
     let repeated = |g: &Geometry| match method {
-        Method::Recall(recalled) => recalled.repeated_at(g),
+        Method::Recall(recalled) => recalled.repeated_at(g).map(|checks| (recalled, checks)),
         _ => None,
     };
     let model = problem.model;
@@ -1602,11 +1602,9 @@ fn solve_geometry(
         {
             // φ0 of the accepted state (charge control; the moment does not feed back), or
             // the recalled state's when this is that state again.
-            (state.charge, state.potential) = match (repeated, method) {
-                (Some(_), Method::Recall(recalled)) => {
-                    (recalled.state.charge, recalled.state.potential)
-                }
-                _ => {
+            (state.charge, state.potential) = match repeated {
+                Some((recalled, _)) => (recalled.state.charge, recalled.state.potential),
+                None => {
                     let j_q = arcsine_moment(&state);
                     electric_resultants(model, g.a, problem.normal_load, j_q)
                 }
@@ -1619,7 +1617,10 @@ fn solve_geometry(
         // every later evaluation of every state whose chain holds it, one more per cycle).
         state.tabulate_shape();
         state.drop_negligible_correction(model.friction);
-        let admissibility = repeated.unwrap_or_else(|| assess_step(model, start, &state));
+        let admissibility = match repeated {
+            Some((_, checks)) => checks,
+            None => assess_step(model, start, &state),
+        };
         check(&admissibility, options.admissibility)?;
         Ok(SlipStep {
             state,
