@@ -347,39 +347,36 @@ struct TraceStep {
     increments: TracedIncrements,
 }
 
-/// A traced step's increments and what a later step must share with it to take them instead
-/// of computing them: the increments are a function of the two states and the anchor.
+/// A traced step's increments, for a later step that repeats it: they are a function of the
+/// two states and the anchor.
 #[derive(Debug, Clone)]
 struct TracedIncrements {
     /// [`Footprint`] of the state the step began from.
     from: Footprint,
-    /// [`Footprint`] of the step's state.
-    at: Footprint,
     /// The increments and the anchor they were taken at, set when the step is finished
     /// ([`finish_step`]).
     value: Arc<OnceLock<(f64, StepIncrements)>>,
 }
 
 impl TracedIncrements {
-    /// The increments, for a step from a state of footprint `from` to one of footprint `at`
-    /// with δ followed at `anchor`, when these are the traced step's and its increments are
-    /// known.
-    fn for_step(&self, from: Footprint, at: Footprint, anchor: f64) -> Option<StepIncrements> {
-        let (taken_at, increments) = self.value.get()?;
-        (self.began_from(from) && self.at == at && taken_at.to_bits() == anchor.to_bits())
-            .then_some(*increments)
-    }
-
     /// Whether the traced step began from a state of footprint `from`.
     fn began_from(&self, from: Footprint) -> bool {
         self.from == from
     }
+
+    /// The increments, for a step that repeated the traced one (`SlipStep::repeated`, which
+    /// the solver grants only to a step that began where the traced one began) with δ
+    /// followed at `anchor`, once they are known.
+    fn for_repeat(&self, anchor: f64) -> Option<StepIncrements> {
+        let (taken_at, increments) = self.value.get()?;
+        (taken_at.to_bits() == anchor.to_bits()).then_some(*increments)
+    }
 }
 
-/// The bits of a state's stick ends, contact half-width and centre, and slip signs. A
-/// recalled step that is accepted at the recalled geometry (its first evaluation solves it
-/// to the tolerance, as in a steady cycle) has the recalled state's footprint; one that had
-/// to iterate has moved off it.
+/// The bits of a state's stick ends, contact half-width and centre, and slip signs: a state
+/// that began a traced step and the state a later step begins from are the same state when
+/// their footprints are equal (the later one a repeat of the earlier, accepted at its geometry
+/// without iterating).
 type Footprint = [u64; 6];
 
 fn footprint(state: &ContactState) -> Footprint {
@@ -914,10 +911,11 @@ pub fn solve_step(
         ),
         jacobian: solved.jacobian,
     });
-    let at = footprint(&solved.state);
-    // A step that reproduced the recalled one from the state that one began from, with the
-    // same anchor, has its increments (module docs, "Recall of a repeated phase").
-    let known = traced.and_then(|t| t.increments.for_step(from, at, driver.anchor));
+    // A step that repeated the recalled one, with the same anchor, has its increments
+    // (module docs, "Recall of a repeated phase").
+    let known = traced
+        .filter(|_| solved.repeated)
+        .and_then(|t| t.increments.for_repeat(driver.anchor));
     let old = std::mem::replace(&mut driver.state, solved.state.clone());
     driver.history.push(load_and_geometry(&driver.state));
     if driver.history.len() > HISTORY_POINTS {
@@ -939,7 +937,6 @@ pub fn solve_step(
         },
         increments: TracedIncrements {
             from,
-            at,
             value: Arc::clone(&increments),
         },
     });
@@ -1185,11 +1182,12 @@ pub fn run_history(
 mod tests {
     use super::*;
 
-    /// A traced step's increments go to a later step only when it began from the state the
-    /// traced step began from, reached the traced step's state (footprints equal to the bit)
-    /// and follows δ at the same anchor, and only once they are known.
+    /// A traced step's increments go to a later step only when it begins from the state the
+    /// traced step began from (footprints equal to the bit; that it then repeated the traced
+    /// step, at its geometry to the bit, is the solver's `repeated`, tested in the tangential
+    /// module) and follows δ at the same anchor, and only once they are known.
     #[test]
-    fn traced_increments_need_both_states_and_the_anchor() {
+    fn traced_increments_need_the_start_and_the_anchor() {
         let increments = StepIncrements {
             displacement: 1e-9,
             dissipation: 2e-9,
@@ -1198,37 +1196,23 @@ mod tests {
             new_ux: 4e-9,
             new_approach: 5e-9,
         };
-        let (from, at, anchor) = ([1, 2, 3, 4, 5, 6], [7, 8, 9, 10, 11, 12], 1e-6);
+        let (from, anchor) = ([1, 2, 3, 4, 5, 6], 1e-6);
         let traced = TracedIncrements {
             from,
-            at,
             value: Arc::new(OnceLock::new()),
         };
-        assert!(
-            traced.for_step(from, at, anchor).is_none(),
-            "not yet finished"
-        );
+        assert!(traced.for_repeat(anchor).is_none(), "not yet finished");
         traced.value.set((anchor, increments)).unwrap();
-        let got = traced
-            .for_step(from, at, anchor)
-            .expect("the traced step's");
+        let got = traced.for_repeat(anchor).expect("the traced step's");
         assert_eq!(got.dissipation.to_bits(), increments.dissipation.to_bits());
+        assert!(traced.began_from(from));
         for k in 0..6 {
             let mut other = from;
             other[k] += 1;
-            assert!(
-                traced.for_step(other, at, anchor).is_none(),
-                "from, bit {k}"
-            );
-            let mut other = at;
-            other[k] += 1;
-            assert!(
-                traced.for_step(from, other, anchor).is_none(),
-                "at, bit {k}"
-            );
+            assert!(!traced.began_from(other), "from, bit {k}");
         }
         let next = f64::from_bits(anchor.to_bits() + 1);
-        assert!(traced.for_step(from, at, next).is_none(), "anchor");
+        assert!(traced.for_repeat(next).is_none(), "anchor");
     }
 
     /// The predictor is the polynomial through the phase's last steps: exact for a quadratic

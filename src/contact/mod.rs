@@ -1872,24 +1872,18 @@ impl ContactState {
         pts
     }
 
-    /// Surface tangential displacement `ux(x)` with the regularised kernel of seed eq. (4),
-    /// `∫₀^∞ cos(sr)/s ds → −ln(|r|/d)`:
+    /// The surface tangential displacement `ux(x)` and the normal approach δn of the punch.
+    ///
+    /// `ux` with the regularised kernel of seed eq. (4), `∫₀^∞ cos(sr)/s ds → −ln(|r|/d)`:
     /// `ux(x) = −½ ∫ ((w12 + χ w13) p + w13 w)(s) sign(x − s) ds − (y11/π) ∫ q(s) ln(|x − s|/d) ds`.
     /// The datum d adds `(y11/π) ln(d) Q`, a term linear in Q.
-    pub fn surface_displacement(&self, model: &ContactModel, x: f64) -> f64 {
-        self.displacement_and_approach(model, x).0
-    }
-
-    /// Normal approach of the punch `δn = uz(x) + x²/(2R)` (any x in the contact; evaluated at
-    /// the contact centre), with `uz(x) = ½∫ w12 q(s) sign(x − s) ds − (1/π)∫ (y22 p + y23 g)(s)
-    /// ln(|x − s|/d) ds` (eq. B integrated with the regularised kernel).
-    pub fn normal_approach(&self, model: &ContactModel) -> f64 {
-        self.displacement_and_approach(model, self.centre).1
-    }
-
-    /// `(ux(x), δn)` ([`Self::surface_displacement`], [`Self::normal_approach`]) from one
-    /// evaluation of p, w and q on the nodes of [`Self::contact_integral`]'s rule, split at
-    /// both x and the contact centre. Each logarithm's singularity is taken out,
+    ///
+    /// `δn = uz(x) + x²/(2R)` (any x in the contact; evaluated at the contact centre), with
+    /// `uz(x) = ½∫ w12 q(s) sign(x − s) ds − (1/π)∫ (y22 p + y23 g)(s) ln(|x − s|/d) ds`
+    /// (eq. B integrated with the regularised kernel).
+    ///
+    /// Both from one evaluation of p, w and q on the nodes of [`Self::contact_integral`]'s
+    /// rule, split at both x and the contact centre. Each logarithm's singularity is taken out,
     /// `∫ (f(s) − f(x)) ln(|x − s|/d) ds + f(x) ∫ ln(|x − s|/d) ds` (the second integral in
     /// closed form), so that the rule suffices. Measured on the default history (M = 64, 32
     /// nodes per piece): δ within 1e−18 m (1e−10 of its range) of a 256-node rule, where the

@@ -234,6 +234,10 @@ pub struct SlipStep {
     /// end, a starting Jacobian for the next step.
     #[serde(skip)]
     pub jacobian: [[f64; 4]; 4],
+    /// Whether the step is a recalled step again (accepted at its geometry to the bit, from
+    /// its start: [`Recalled::admissibility`]), whose checks and φ0 it took.
+    #[serde(skip)]
+    pub repeated: bool,
 }
 
 /// The four geometric unknowns of a step: stick-zone ends and contact half-width and centre.
@@ -1629,6 +1633,7 @@ fn solve_geometry(
             residual,
             admissibility,
             jacobian: jac.unwrap_or([[0.0; 4]; 4]),
+            repeated: repeated.is_some(),
         })
     };
     let mut iterations = 0;
