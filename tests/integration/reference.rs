@@ -1738,3 +1738,87 @@ fn remembered_end_next_to_a_new_stick_end_stays_converged() {
     assert!(ends < 6e-4, "stick ends {ends:e} a");
     assert!(dissipation < 1e-2, "step dissipation {dissipation:e}");
 }
+
+/// A step that the recalled state solves at the recalled geometry to the bit, but that began
+/// from another state, is not a repeat: it computes its own increments. The default history at
+/// M = 32 is run to −½ ηP (phases 1–4, steps of 0.05 ηP); phase 5 then goes from −0.45 ηP
+/// straight to −0.30 ηP, where it recalls phase 3's step, which began from −0.35 ηP. Measured:
+/// the step's Δδ is 3.0 times the recalled step's and its dissipation 1.03 times; its
+/// dissipation equals the one evaluated from its two states (the same computation), and δ at
+/// +½ ηP, where phase 5 reaches phase 3's state, closes on phase 3's δ to 5e−16 of the loop's
+/// δ range (bound 1e−12). Taking the recalled step's increments would leave δ short by 0.1 of
+/// that range. (The step's checks are its own too, but here its slip-reversal measure is the
+/// recalled step's, 0, so they would not tell.)
+#[test]
+fn a_recalled_step_from_another_start_computes_its_own_increments() {
+    use fretsim::history::{StepRecord, step_dissipation};
+    let b = baseline(32);
+    // The loads as multiples of 0.05 ηP, one step per knot: phases 1–4, then phase 5 without
+    // −0.40 and −0.35 ηP.
+    let mut loads: Vec<i32> = (1..=10).collect();
+    loads.extend((-10..=9).rev());
+    loads.extend(-9..=10);
+    loads.extend((-10..=9).rev());
+    let before_5 = loads.len();
+    loads.push(-9);
+    loads.extend(-6..=10);
+    let mut points = vec![(0.0, 0.0)];
+    points.extend(
+        loads
+            .iter()
+            .enumerate()
+            .map(|(i, &k)| ((i + 1) as f64, 0.05 * f64::from(k) * b.lim)),
+    );
+    let history = fretsim::history::LoadHistory {
+        points,
+        steps_per_segment: 1,
+        max_step: 0.15 * b.lim,
+    };
+    let mut recorder = Recorder::default();
+    let run = fretsim::history::run_history(
+        &b.model,
+        &b.disc,
+        &b.normal,
+        &history,
+        fretsim::contact::tangential::SlipOptions::default(),
+        &mut recorder,
+    )
+    .unwrap();
+    let (records, states) = (&run.records, &recorder.states);
+    // The first step after step `from` to `k` × 0.05 ηP.
+    let step_to =
+        |from: usize, k: i32| from + 1 + loads[from..].iter().position(|&l| l == k).unwrap();
+    let (recalled, skipping) = (step_to(30, -6), step_to(before_5, -6));
+    assert_eq!(
+        loads[skipping - 2],
+        -9,
+        "phase 5 reaches −0.30 ηP from −0.45 ηP"
+    );
+    let geometry =
+        |r: &StepRecord| [r.stick_lo, r.stick_hi, r.half_width, r.eccentricity].map(f64::to_bits);
+    assert_eq!(
+        geometry(&records[skipping]),
+        geometry(&records[recalled]),
+        "the recalled state solves the step at its own geometry"
+    );
+    let change = |k: usize| records[k].displacement - records[k - 1].displacement;
+    let ratio = change(skipping) / change(recalled);
+    assert!(
+        ratio > 2.0,
+        "Δδ of the longer step: {ratio} times the recalled one's"
+    );
+    let dissipation = step_dissipation(&b.model, &states[skipping - 1], &states[skipping]);
+    let got = records[skipping].dissipation;
+    let error = (got - dissipation).abs() / dissipation.abs();
+    assert!(error < 1e-12, "dissipation {got:e} vs {dissipation:e}");
+    // δ at +½ ηP: phase 5 closes on phase 3.
+    let (end_3, end_5) = (step_to(30, 10), step_to(before_5, 10));
+    let (low, high) = records[30..=end_3]
+        .iter()
+        .map(|r| r.displacement)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), d| {
+            (l.min(d), h.max(d))
+        });
+    let gap = (records[end_5].displacement - records[end_3].displacement).abs() / (high - low);
+    assert!(gap < 1e-12, "δ at +½ ηP: {gap:e} of the loop's range");
+}
