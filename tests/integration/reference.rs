@@ -1026,10 +1026,14 @@ fn coupled_cycle_masing_return_and_step_refinement() {
 
 /// Convergence in M of the default history (PZT-4 baseline, ±½ ηP, steps of 0.05 ηP; two
 /// cycles), the quantities of the performance issue's accuracy target: the stick ends at the
-/// turning points and the friction work of the last cycle, M = 64 against M = 128. The kinks
-/// of p and w at the stick ends (new and remembered) are what make them converge: measured
-/// 2.6e−5 a and 1.3e−4 of the work (against M = 512: 7.7e−5 a and 9e−5 at M = 64); without
-/// the kinks 8.0e−4 a and 1.1e−3. The bounds are about twice the measured differences.
+/// turning points and at every step, and the friction work of the last cycle, M = 64 against
+/// M = 128. The kinks of p and w at the stick ends (new and remembered) are what make them
+/// converge: measured 2.6e−5 a at the turning points, 3.0e−4 a at the worst step (step 69,
+/// where a remembered stick end lies 0.016a inside the new one) and 1.3e−4 of the work;
+/// without the kinks 8.0e−4 a and 1.1e−3 at the turning points. The bounds are about twice the
+/// measured differences. Two coarse resolutions agreeing is a guard against regressions, not
+/// a proof of convergence: at the +½ ηP turning state M = 64 and 128 agree to 7e−6 a and are
+/// both 1.2e−4 a from M = 2048 (`docs/performance.md`, "Every step against M = 2048").
 #[test]
 fn default_history_stick_ends_and_work_converge_in_m() {
     let lim = baseline(64).lim;
@@ -1044,6 +1048,7 @@ fn default_history_stick_ends_and_work_converge_in_m() {
             .map(|r| (r.stick_lo, r.stick_hi))
             .collect();
         assert_eq!(turning.len(), 5);
+        let every: Vec<(f64, f64)> = recs.iter().map(|r| (r.stick_lo, r.stick_hi)).collect();
         // The last cycle: from the −½ ηP turning point at t = 5 ... 9 (the +½ at t = 5, then
         // −½ at 7 and +½ at 9): the dissipation of the steps after t = 5.
         let work: f64 = recs
@@ -1051,18 +1056,26 @@ fn default_history_stick_ends_and_work_converge_in_m() {
             .filter(|r| r.t > 5.0 + 1e-9)
             .map(|r| r.dissipation)
             .sum();
-        runs.push((b.normal.state.half_width, turning, work));
+        runs.push((b.normal.state.half_width, turning, every, work));
     }
-    let (a, coarse, w64) = &runs[0];
-    let (_, fine, w128) = &runs[1];
-    let ends = coarse
-        .iter()
-        .zip(fine)
-        .flat_map(|(x, y)| [x.0 - y.0, x.1 - y.1])
-        .fold(0.0f64, |w, d| w.max(d.abs() / a));
+    let (a, coarse, coarse_every, w64) = &runs[0];
+    let (_, fine, fine_every, w128) = &runs[1];
+    let worst = |x: &[(f64, f64)], y: &[(f64, f64)]| {
+        assert_eq!(x.len(), y.len());
+        x.iter()
+            .zip(y)
+            .flat_map(|(x, y)| [x.0 - y.0, x.1 - y.1])
+            .fold(0.0f64, |w, d| w.max(d.abs() / a))
+    };
+    let ends = worst(coarse, fine);
+    let steps = worst(coarse_every, fine_every);
     let work = ((w64 - w128) / w128).abs();
-    eprintln!("M = 64 against 128: stick ends {ends:e} a, last cycle's friction work {work:e}");
+    eprintln!(
+        "M = 64 against 128: stick ends {ends:e} a at the turning points, {steps:e} a at the \
+         worst step, last cycle's friction work {work:e}"
+    );
     assert!(ends < 6e-5, "{ends:e}");
+    assert!(steps < 6e-4, "{steps:e}");
     assert!(work < 3e-4, "{work:e}");
 }
 
