@@ -427,9 +427,11 @@ impl StepProblem<'_> {
         );
         // The kinks of p and w: at the new stick ends, whose q̃ roots are unknowns of the inner
         // iteration, estimated from q̃ at `END_PROBE` and twice that of the half-width inside
-        // each end (see `EndProbes`), and at the remembered stick ends inside the zone, whose
+        // each end (nearer where a remembered end is close, see `EndProbes`), and at the
+        // remembered stick ends inside the zone, whose
         // roots the chain carries.
-        let probes = EndProbes::new(g, m, &closed);
+        let interior_points: Vec<f64> = interior.iter().map(|r| r.at).collect();
+        let probes = EndProbes::new(g, m, &closed, &interior_points);
         let kinks = if coupled {
             let mut points = vec![
                 (g.lo, -1.0, 0.0, self.signs.0),
@@ -860,29 +862,58 @@ const END_PROBE: f64 = 0.01;
 /// The square-root coefficients of q̃ (own series and inherited correction) at the stick
 /// ends, `q̃ ≈ k_lo √(x − lo)` and `q̃ ≈ k_hi √(hi − x)`, by Richardson's extrapolation of
 /// `q̃/√r` from the distances `r = d` and `2d` (`d = END_PROBE h`): `k ≈ 2 q̃(d)/√d − q̃(2d)/√(2d)`,
-/// exact for `k√r (1 + c r)`. Reading k from the series' end values `ψ(±1)` instead (the exact
-/// limit of a polynomial) is ill-conditioned: the sum `Σ (±1)ⁿ (n + 1) β_n` weighs the
+/// exact for `k√r (1 + c r)`. Where a remembered stick end inside the zone (whose root q̃
+/// carries, [`super::RememberedRoot`]) lies closer to an end than `4d`, d there is a quarter
+/// of its distance, so that both probes read the stretch between the two roots (unless that
+/// puts them closer to the end than the series' first node: then d stays): in a steady
+/// cycle the extreme states' stick ends lie about 0.01a apart, and probes straddling the
+/// remembered one misread k, whose kinks the series then had to carry (measured, default
+/// history against M = 2048: the worst stick end at M = 64 2.1e−4 → 8.2e−5 a, at M = 128
+/// 1.15e−4 → 2.8e−5 a; `docs/performance.md`). Reading k from the series' end values `ψ(±1)`
+/// instead (the exact limit of a polynomial) is ill-conditioned: the sum `Σ (±1)ⁿ (n + 1) β_n` weighs the
 /// coefficients' tail, and at M = 256 it moved by 1e−3 of itself between evaluations 1e−6 a
 /// apart, which stalled steps at residuals of 1e−7. The coefficients are carried scaled by
 /// `scale = √h` (Pa, the scale of q̃).
 struct EndProbes {
-    /// Density rows of the own series at `lo + d`, `lo + 2d`, `hi − d`, `hi − 2d`.
+    /// Density rows of the own series at `lo + d_lo`, `lo + 2d_lo`, `hi − d_hi`, `hi − 2d_hi`.
     rows: [Vec<f64>; 4],
     /// The closed-form part of q̃ (inherited chain and extras) at the same points.
     closed: [f64; 4],
     /// The same points (m).
     points: [f64; 4],
-    /// d (m).
-    d: f64,
+    /// d at the left and right end (m).
+    d: [f64; 2],
     /// √h.
     scale: f64,
 }
 
 impl EndProbes {
-    fn new(g: &Geometry, m: usize, closed: &StickZone) -> Self {
+    fn new(g: &Geometry, m: usize, closed: &StickZone, interior: &[f64]) -> Self {
         let half = 0.5 * (g.hi - g.lo);
-        let d = END_PROBE * half;
-        let points = [g.lo + d, g.lo + 2.0 * d, g.hi - d, g.hi - 2.0 * d];
+        let near = |end: f64| {
+            interior
+                .iter()
+                .map(|x| (x - end).abs())
+                .fold(f64::INFINITY, f64::min)
+        };
+        // A probe closer to the end than the series' first node, `h (1 − cos(π/(M + 1)))`,
+        // reads what the series cannot resolve; there the standard probes are kept.
+        let standard = END_PROBE * half;
+        let floor = half * (1.0 - (std::f64::consts::PI / (m + 1) as f64).cos());
+        let d = [g.lo, g.hi].map(|end| {
+            let clear = 0.25 * near(end);
+            if clear < standard && clear >= floor {
+                clear
+            } else {
+                standard
+            }
+        });
+        let points = [
+            g.lo + d[0],
+            g.lo + 2.0 * d[0],
+            g.hi - d[1],
+            g.hi - 2.0 * d[1],
+        ];
         let rows = points.map(|x| {
             let mut row = vec![0.0; m];
             BoundedSeries::density_row((x - 0.5 * (g.lo + g.hi)) / half, &mut row);
@@ -899,9 +930,10 @@ impl EndProbes {
 
     /// `[k_lo, k_hi]` times `scale` from q̃ at the four points.
     fn extrapolate(&self, v: [f64; 4]) -> [f64; 2] {
-        let (r1, r2) = (self.d.sqrt(), (2.0 * self.d).sqrt());
-        let root = |near: f64, far: f64| (2.0 * near / r1 - far / r2) * self.scale;
-        [root(v[0], v[1]), root(v[2], v[3])]
+        let root = |near: f64, far: f64, d: f64| {
+            (2.0 * near / d.sqrt() - far / (2.0 * d).sqrt()) * self.scale
+        };
+        [root(v[0], v[1], self.d[0]), root(v[2], v[3], self.d[1])]
     }
 
     /// The scaled coefficients of the q̃ whose own series is `beta`.
@@ -1892,6 +1924,42 @@ pub fn assess_step(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The end probes keep clear of a remembered stick end near a new one: a quarter and a half
+    /// of its distance from the end when it lies within `4 END_PROBE h`, unless that is closer
+    /// to the end than the series' first node; elsewhere `END_PROBE h` and twice that.
+    #[test]
+    fn end_probes_keep_clear_of_a_remembered_end() {
+        let g = Geometry {
+            lo: -1.0,
+            hi: 1.0,
+            a: 1.2,
+            c: 0.0,
+        };
+        let m = 64;
+        let zone = StickZone::new(g.lo, g.hi, BoundedSeries::default(), 0.0);
+        let first_node = 1.0 - (std::f64::consts::PI / 65.0).cos();
+        // h = 1: a remembered end 0.015 inside the right end, one 0.5 inside the left.
+        let probes = EndProbes::new(&g, m, &zone, &[-0.5, 1.0 - 0.015]);
+        let close = |x: f64, y: f64| (x - y).abs() < 1e-15;
+        assert!(close(probes.d[0], END_PROBE) && close(probes.d[1], 0.015 / 4.0));
+        assert!(close(probes.points[2], 1.0 - 0.015 / 4.0));
+        assert!(close(probes.points[3], 1.0 - 0.015 / 2.0));
+        // A quarter of the distance below the first node: the standard probes.
+        let probes = EndProbes::new(&g, m, &zone, &[1.0 - 3.0 * first_node]);
+        assert!(probes.d.iter().all(|&d| close(d, END_PROBE)));
+        // Nothing remembered nearby.
+        let probes = EndProbes::new(&g, m, &zone, &[]);
+        assert!(probes.d.iter().all(|&d| close(d, END_PROBE)));
+        // The extrapolation is exact for k √r (1 + c r) at either spacing.
+        let q = |r: f64| 3.0 * r.sqrt() * (1.0 + 0.7 * r);
+        let probes = EndProbes::new(&g, m, &zone, &[1.0 - 0.015]);
+        let [left, right] = probes.scaled_roots(|x| q((x - g.lo).min(g.hi - x)));
+        assert!(
+            (left - 3.0).abs() < 1e-12 && (right - 3.0).abs() < 1e-12,
+            "{left} {right}"
+        );
+    }
 
     /// A recalled step's checks are taken only at its geometry to the bit, and only when the
     /// caller gave them (the step begins from the recalled step's start).

@@ -1028,12 +1028,14 @@ fn coupled_cycle_masing_return_and_step_refinement() {
 /// cycles), the quantities of the performance issue's accuracy target: the stick ends at the
 /// turning points and at every step, and the friction work of the last cycle, M = 64 against
 /// M = 128. The kinks of p and w at the stick ends (new and remembered) are what make them
-/// converge: measured 2.6e−5 a at the turning points, 3.0e−4 a at the worst step (step 69,
-/// where a remembered stick end lies 0.016a inside the new one) and 1.3e−4 of the work;
+/// converge: measured 2.6e−5 a at the turning points, 1.8e−4 a at the worst step and 5.3e−5
+/// of the work (before the end probes kept clear of a remembered stick end just inside the new
+/// one, twelfth session: 3.0e−4 a at step 69, where it lies 0.016a inside, and 1.3e−4);
 /// without the kinks 8.0e−4 a and 1.1e−3 at the turning points. The bounds are about twice the
 /// measured differences. Two coarse resolutions agreeing is a guard against regressions, not
-/// a proof of convergence: at the +½ ηP turning state M = 64 and 128 agree to 7e−6 a and are
-/// both 1.2e−4 a from M = 2048 (`docs/performance.md`, "Every step against M = 2048").
+/// a proof of convergence: before that change M = 64 and 128 agreed at the +½ ηP turning state
+/// to 7e−6 a while both were 1.2e−4 a from M = 2048 (`docs/performance.md`, "Every step
+/// against M = 2048").
 #[test]
 fn default_history_stick_ends_and_work_converge_in_m() {
     let lim = baseline(64).lim;
@@ -1075,8 +1077,8 @@ fn default_history_stick_ends_and_work_converge_in_m() {
          worst step, last cycle's friction work {work:e}"
     );
     assert!(ends < 6e-5, "{ends:e}");
-    assert!(steps < 6e-4, "{steps:e}");
-    assert!(work < 3e-4, "{work:e}");
+    assert!(steps < 4e-4, "{steps:e}");
+    assert!(work < 1.1e-4, "{work:e}");
 }
 
 /// The kinks switched off (`numerics.stick_end_kinks = false`): the plain series of the seed
