@@ -81,8 +81,9 @@
 //! ```
 //!
 //! (`P`, the 4 % root of p on the stick side, and the departure of the true exponent from ½
-//! are left to the series; that exponent is ½ ∓ γ next to slip of sign ±1, γ the contact
-//! ends' (`docs/performance.md`, "Every step against M = 2048").) k itself is read off q̃ inside each end (`EndProbes`: Richardson's
+//! are left to the series; that exponent is ½ ∓ γ at a right end next to slip of sign ±1
+//! (mirrored at a left end), γ the contact ends' (`docs/performance.md`, "Every step against
+//! M = 2048").) k itself is read off q̃ inside each end (`EndProbes`: Richardson's
 //! extrapolation of `q̃/√r` from `r = 0.01 h` and `0.02 h`, h the stick half-width, own series
 //! plus inherited part); the series' end value `ψ(±1)` would be the exact limit but is
 //! ill-conditioned. The new ends' two k are unknowns of the inner iteration; a term on a
