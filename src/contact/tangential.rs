@@ -512,7 +512,10 @@ impl StepProblem<'_> {
             // Pressure for the current shear traction (seed eqs. 52, 54, 56), less the Cauchy
             // transform of its kinks.
             let ends = if coupled {
-                [x[np + nc] / probes.scale, x[np + nc + 1] / probes.scale]
+                [
+                    x[np + nc] / probes.scale[0],
+                    x[np + nc + 1] / probes.scale[1],
+                ]
             } else {
                 [0.0; 2]
             };
@@ -874,7 +877,10 @@ const END_PROBE: f64 = 0.01;
 /// instead (the exact limit of a polynomial) is ill-conditioned: the sum `Σ (±1)ⁿ (n + 1) β_n` weighs the
 /// coefficients' tail, and at M = 256 it moved by 1e−3 of itself between evaluations 1e−6 a
 /// apart, which stalled steps at residuals of 1e−7. The coefficients are carried scaled by
-/// `scale = √h` (Pa, the scale of q̃).
+/// `scale = √d` of their end (Pa, `k √d = 2 q̃(d) − q̃(2d)/√2`: the root's part of q̃ at the
+/// probes), so that the inner iteration converges them as far as the traction; scaled by √h,
+/// their round-off, amplified by `√(h/d)`, kept the inner iteration of a recalled step at
+/// M = 512 at its tolerance for ten passes instead of four once the probes moved nearer.
 struct EndProbes {
     /// Density rows of the own series at `lo + d_lo`, `lo + 2d_lo`, `hi − d_hi`, `hi − 2d_hi`.
     rows: [Vec<f64>; 4],
@@ -882,10 +888,9 @@ struct EndProbes {
     closed: [f64; 4],
     /// The same points (m).
     points: [f64; 4],
-    /// d at the left and right end (m).
-    d: [f64; 2],
-    /// √h.
-    scale: f64,
+    /// √d at each end: a root's effect on q̃ at the probes, so that the inner iteration
+    /// converges the roots as far as it does the traction.
+    scale: [f64; 2],
 }
 
 impl EndProbes {
@@ -924,17 +929,15 @@ impl EndProbes {
             rows,
             closed: points.map(|x| closed.correction_at(x)),
             points,
-            d,
-            scale: half.sqrt(),
+            scale: d.map(f64::sqrt),
         }
     }
 
     /// `[k_lo, k_hi]` times `scale` from q̃ at the four points.
     fn extrapolate(&self, v: [f64; 4]) -> [f64; 2] {
-        let root = |near: f64, far: f64, d: f64| {
-            (2.0 * near / d.sqrt() - far / (2.0 * d).sqrt()) * self.scale
-        };
-        [root(v[0], v[1], self.d[0]), root(v[2], v[3], self.d[1])]
+        // k √d = 2 q̃(d) − q̃(2d)/√2.
+        let root = |near: f64, far: f64| 2.0 * near - far * std::f64::consts::FRAC_1_SQRT_2;
+        [root(v[0], v[1]), root(v[2], v[3])]
     }
 
     /// The scaled coefficients of the q̃ whose own series is `beta`.
@@ -1943,22 +1946,24 @@ mod tests {
         // h = 1: a remembered end 0.015 inside the right end, one 0.5 inside the left.
         let probes = EndProbes::new(&g, m, &zone, &[-0.5, 1.0 - 0.015]);
         let close = |x: f64, y: f64| (x - y).abs() < 1e-15;
-        assert!(close(probes.d[0], END_PROBE) && close(probes.d[1], 0.015 / 4.0));
+        let d = probes.scale.map(|s| s * s);
+        assert!(close(d[0], END_PROBE) && close(d[1], 0.015 / 4.0));
         assert!(close(probes.points[2], 1.0 - 0.015 / 4.0));
         assert!(close(probes.points[3], 1.0 - 0.015 / 2.0));
         // A quarter of the distance below the first node: the standard probes.
         let probes = EndProbes::new(&g, m, &zone, &[1.0 - 3.0 * first_node]);
-        assert!(probes.d.iter().all(|&d| close(d, END_PROBE)));
+        assert!(probes.scale.iter().all(|&s| close(s * s, END_PROBE)));
         // Nothing remembered nearby.
         let probes = EndProbes::new(&g, m, &zone, &[]);
-        assert!(probes.d.iter().all(|&d| close(d, END_PROBE)));
+        assert!(probes.scale.iter().all(|&s| close(s * s, END_PROBE)));
         // The extrapolation is exact for k √r (1 + c r) at either spacing.
         let q = |r: f64| 3.0 * r.sqrt() * (1.0 + 0.7 * r);
         let probes = EndProbes::new(&g, m, &zone, &[1.0 - 0.015]);
         let [left, right] = probes.scaled_roots(|x| q((x - g.lo).min(g.hi - x)));
+        let (kl, kr) = (left / probes.scale[0], right / probes.scale[1]);
         assert!(
-            (left - 3.0).abs() < 1e-12 && (right - 3.0).abs() < 1e-12,
-            "{left} {right}"
+            (kl - 3.0).abs() < 1e-12 && (kr - 3.0).abs() < 1e-12,
+            "{kl} {kr}"
         );
     }
 
