@@ -85,7 +85,8 @@
 //! (mirrored at a left end), γ the contact ends' (`docs/performance.md`, "Every step against
 //! M = 2048").) k itself is read off q̃ inside each end (`EndProbes`: Richardson's
 //! extrapolation of `q̃/√r` from `r = 0.01 h` and `0.02 h`, h the stick half-width, own series
-//! plus inherited part); the series' end value `ψ(±1)` would be the exact limit but is
+//! plus inherited part; nearer the end where a remembered stick end lies within `0.04 h`, so
+//! that the probes do not straddle its root); the series' end value `ψ(±1)` would be the exact limit but is
 //! ill-conditioned. The new ends' two k are unknowns of the inner iteration; a term on a
 //! stretch the grid does not resolve is switched off smoothly (`resolved`).
 //!
@@ -429,8 +430,7 @@ impl StepProblem<'_> {
         // The kinks of p and w: at the new stick ends, whose q̃ roots are unknowns of the inner
         // iteration, estimated from q̃ at `END_PROBE` and twice that of the half-width inside
         // each end (nearer where a remembered end is close, see `EndProbes`), and at the
-        // remembered stick ends inside the zone, whose
-        // roots the chain carries.
+        // remembered stick ends inside the zone, whose roots the chain carries.
         let interior_points: Vec<f64> = interior.iter().map(|r| r.at).collect();
         let probes = EndProbes::new(g, m, &closed, &interior_points);
         let kinks = if coupled {
@@ -874,9 +874,9 @@ const END_PROBE: f64 = 0.01;
 /// remembered one misread k, whose kinks the series then had to carry (measured, default
 /// history against M = 2048: the worst stick end at M = 64 2.1e−4 → 8.2e−5 a, at M = 128
 /// 1.15e−4 → 2.8e−5 a; `docs/performance.md`). Reading k from the series' end values `ψ(±1)`
-/// instead (the exact limit of a polynomial) is ill-conditioned: the sum `Σ (±1)ⁿ (n + 1) β_n` weighs the
-/// coefficients' tail, and at M = 256 it moved by 1e−3 of itself between evaluations 1e−6 a
-/// apart, which stalled steps at residuals of 1e−7. The coefficients are carried scaled by
+/// instead (the exact limit of a polynomial) is ill-conditioned: the sum
+/// `Σ (±1)ⁿ (n + 1) β_n` weighs the coefficients' tail, and at M = 256 it moved by 1e−3 of
+/// itself between evaluations 1e−6 a apart, which stalled steps at residuals of 1e−7. The coefficients are carried scaled by
 /// `scale = √d` of their end (Pa, `k √d = 2 q̃(d) − q̃(2d)/√2`: the root's part of q̃ at the
 /// probes), so that the inner iteration converges them as far as the traction; scaled by √h,
 /// their round-off, amplified by `√(h/d)`, kept the inner iteration of a recalled step at
