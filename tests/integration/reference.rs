@@ -1400,9 +1400,9 @@ fn recalled_cycles_repeat_the_solved_ones() {
 /// checked against evaluating them. Phases 5–9 recall phases 3–7 whole: the turning state at
 /// −½ ηP that begins phase 5 is the Masing return to the one that began phase 3, at its
 /// geometry to the bit, so from step 71 on every step is known. Measured: Δδ, the dissipation
-/// and the anchor's ux agree to 2.8e−14 of the largest of each, δn and the work of P to
-/// 3.9e−16 of the largest P δn (the work is a difference of two δn), the three admissibility
-/// measures to 3.1e−16 and φ0 to 2.1e−16 of itself; the bound is 1e−12. Which differences of
+/// and the anchor's ux agree to 3.9e−14 of the largest of each, δn and the work of P to
+/// 5.1e−16 of the largest P δn (the work is a difference of two δn), the three admissibility
+/// measures to 3.6e−16 and φ0 to 2.1e−16 of itself; the bound is 1e−12. Which differences of
 /// the start state or the anchor stop a step taking the increments is tested in the history
 /// module, which of the geometry stop it repeating the recalled step in the tangential one.
 #[test]
