@@ -851,8 +851,9 @@ fn cycle_verdicts() {
 /// right slip signs exchanged and negated, the same a and dissipation. Run on the paper's
 /// baseline through two reversals of a coupled contact (0 → ½ → −½ → ½ ηP in steps of
 /// 0.05 ηP), where a direction-dependent choice in the state machine (the order in which
-/// slip states are tried, the guesses) would break it. Measured: stick ends, e and a to 5e−14 a,
-/// δ to 1.8e−12 and the dissipation to 6e−13 of their largest values (round-off).
+/// slip states are tried, the guesses) would break it. Measured: stick ends to 1.3e−13 a, e and
+/// a to 1.6e−14 a, δ to 1.7e−13 and the dissipation to 9.7e−13 of their largest values
+/// (round-off; twelfth session).
 #[test]
 fn history_is_mirror_symmetric() {
     let Baseline {
@@ -1108,8 +1109,8 @@ fn figure3_history_completes_without_the_stick_end_kinks() {
 /// 0.5 ηP the state is the first 0.5 ηP state, and continuing to 0.7 ηP gives the state of
 /// monotonic loading 0 → 0.7 ηP (the stick zone beyond 0.5 ηP shrinks inside the first 0.5 ηP
 /// zone, where the memory is that of normal loading on both paths). Measured: at 0.5 ηP the
-/// geometry identical and δ to 2e−15; at 0.7 ηP the geometry to 1.3e−14 a and δ to 8e−15
-/// (round-off).
+/// geometry identical and δ to 2e−15; at 0.7 ηP the geometry to 3.9e−14 a and δ to 1.9e−14
+/// (round-off; 1.3e−14 and 8e−15 before the twelfth session's end probes).
 #[test]
 fn coupled_partial_unload_reload_follows_masing() {
     use fretsim::history::StepRecord;
