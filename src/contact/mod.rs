@@ -733,8 +733,6 @@ pub fn kink_cauchy(u: f64) -> f64 {
 /// five points made steps worse than leaving the remembered kink to the series.
 const FADE_POINTS: f64 = 6.0;
 
-/// `f` at each of `xs` into `out`, four points at a time by `f4`, which must give `f`'s values
-/// bit for bit (the four-point Chebyshev sums of [`crate::quadrature`]).
 /// A zone's own part in one form (density or Cauchy transform): the series at four points,
 /// at one point, and the kink term ([`StickZone::own_parts_into`]).
 type OwnForms = (
@@ -743,6 +741,8 @@ type OwnForms = (
     fn(f64) -> f64,
 );
 
+/// `f` at each of `xs` into `out`, four points at a time by `f4`, which must give `f`'s values
+/// bit for bit (the four-point Chebyshev sums of [`crate::quadrature`]).
 fn in_fours(
     xs: &[f64],
     f4: impl Fn([f64; 4]) -> [f64; 4],

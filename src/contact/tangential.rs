@@ -86,9 +86,10 @@
 //! M = 2048").) k itself is read off q̃ inside each end (`EndProbes`: Richardson's
 //! extrapolation of `q̃/√r` from `r = 0.01 h` and `0.02 h`, h the stick half-width, own series
 //! plus inherited part; nearer the end where a remembered stick end lies within `0.04 h`, so
-//! that the probes do not straddle its root); the series' end value `ψ(±1)` would be the exact limit but is
-//! ill-conditioned. The new ends' two k are unknowns of the inner iteration; a term on a
-//! stretch the grid does not resolve is switched off smoothly (`resolved`).
+//! that the probes do not straddle its root); the series' end value `ψ(±1)` would be the
+//! exact limit but is ill-conditioned. The new ends' two k are unknowns of the inner
+//! iteration; a term on a stretch the grid does not resolve is switched off smoothly
+//! (`resolved`).
 //!
 //! Remembered stick ends inside the new zone keep their kinks: near such a point x0 the
 //! increments since the turning point solve homogeneous equations, so p, w and q keep the
@@ -876,11 +877,12 @@ const END_PROBE: f64 = 0.01;
 /// 1.15e−4 → 2.8e−5 a; `docs/performance.md`). Reading k from the series' end values `ψ(±1)`
 /// instead (the exact limit of a polynomial) is ill-conditioned: the sum
 /// `Σ (±1)ⁿ (n + 1) β_n` weighs the coefficients' tail, and at M = 256 it moved by 1e−3 of
-/// itself between evaluations 1e−6 a apart, which stalled steps at residuals of 1e−7. The coefficients are carried scaled by
-/// `scale = √d` of their end (Pa, `k √d = 2 q̃(d) − q̃(2d)/√2`: the root's part of q̃ at the
-/// probes), so that the inner iteration converges them as far as the traction; scaled by √h,
-/// their round-off, amplified by `√(h/d)`, kept the inner iteration of a recalled step at
-/// M = 512 at its tolerance for ten passes instead of four once the probes moved nearer.
+/// itself between evaluations 1e−6 a apart, which stalled steps at residuals of 1e−7. The
+/// coefficients are carried scaled by `scale = √d` of their end (Pa,
+/// `k √d = 2 q̃(d) − q̃(2d)/√2`: the root's part of q̃ at the probes), so that the inner
+/// iteration converges them as far as the traction; scaled by √h, their round-off, amplified
+/// by `√(h/d)`, kept the inner iteration of a recalled step at M = 512 at its tolerance for
+/// ten passes instead of four once the probes moved nearer.
 struct EndProbes {
     /// Density rows of the own series at `lo + d_lo`, `lo + 2d_lo`, `hi − d_hi`, `hi − 2d_hi`.
     rows: [Vec<f64>; 4],
