@@ -35,7 +35,17 @@ pub struct Discretisation {
     /// collocation points, then at the unbounded ones (2M rows): the pressure at the points
     /// where the tangential solver samples the shear traction.
     pub bounded_at_collocation: RowMatrix,
+    /// The coarse companion grid ([`COARSE_NODES`] nodes, when M is at least twice that), on
+    /// which the tangential solver builds the finite-difference Jacobian of a step.
+    coarse: Option<Box<Discretisation>>,
 }
+
+/// Nodes of the coarse companion grid ([`Discretisation::coarse`]). Its Jacobian of a
+/// tangential step is within about 1.5 % of the fine grid's (the coarse grid's own
+/// discretisation error, which does not shrink between 16 and 48 nodes), and one of its
+/// residual evaluations costs a tenth of one at M = 128; 24 nodes made the forward step
+/// fastest among 16, 24 and 32 at M = 64, 128 and 256 (`docs/performance.md`).
+pub const COARSE_NODES: usize = 24;
 
 impl Discretisation {
     /// Build and factor for M collocation nodes.
@@ -62,12 +72,19 @@ impl Discretisation {
             unit_psi,
             unit_integral,
             bounded_at_collocation,
+            coarse: (m >= 2 * COARSE_NODES).then(|| Box::new(Discretisation::new(COARSE_NODES))),
         }
     }
 
     /// Number of nodes M.
     pub fn nodes(&self) -> usize {
         self.bounded.len()
+    }
+
+    /// The coarse companion grid, when M is at least twice [`COARSE_NODES`] (on a grid not much
+    /// finer, its evaluations would cost about as much as the fine ones they save).
+    pub fn coarse(&self) -> Option<&Discretisation> {
+        self.coarse.as_deref()
     }
 }
 
