@@ -41,10 +41,11 @@ pub struct Discretisation {
 }
 
 /// Nodes of the coarse companion grid ([`Discretisation::coarse`]). Its Jacobian of a
-/// tangential step is within about 1.5 % of the fine grid's (the coarse grid's own
-/// discretisation error, which does not shrink between 16 and 48 nodes), and one of its
-/// residual evaluations costs a tenth of one at M = 128; 24 nodes made the forward step
-/// fastest among 16, 24 and 32 at M = 64, 128 and 256 (`docs/performance.md`).
+/// tangential step is within about 1 % of the fine grid's (the coarse grid's own
+/// discretisation error, which does not shrink between 16 and 48 nodes), and the five
+/// residual evaluations of its Jacobian cost about as much as half of one at M = 128. Of 16,
+/// 24 and 32 nodes, 24 made the forward step fastest (16 and 24 at M = 64, 96 and 256, all
+/// three at M = 128; `docs/performance.md`).
 pub const COARSE_NODES: usize = 24;
 
 impl Discretisation {
