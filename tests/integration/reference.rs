@@ -103,6 +103,62 @@ fn half_amplitude_cycles(limit: f64, turns: usize) -> Vec<(f64, f64)> {
     points
 }
 
+/// The default history (three ±½ ηP cycles in steps of 0.05 ηP) on `b`'s grid with
+/// `options`: its step records.
+fn default_cycles(
+    b: &Baseline,
+    options: fretsim::contact::tangential::SlipOptions,
+) -> Vec<fretsim::history::StepRecord> {
+    use fretsim::history::{LoadHistory, NoObserver, run_history};
+    let history = LoadHistory {
+        points: half_amplitude_cycles(b.lim, 7),
+        steps_per_segment: 10,
+        max_step: 0.05 * b.lim,
+    };
+    run_history(
+        &b.model,
+        &b.disc,
+        &b.normal,
+        &history,
+        options,
+        &mut NoObserver,
+    )
+    .unwrap()
+    .records
+}
+
+/// The largest differences between two runs of the same steps: of the stick ends,
+/// half-width, eccentricity and δ (relative to a), and of the step dissipation (relative to
+/// the largest). The steps must match in number, phase and regime.
+fn record_differences(
+    one: &[fretsim::history::StepRecord],
+    other: &[fretsim::history::StepRecord],
+) -> (f64, f64) {
+    assert_eq!(one.len(), other.len());
+    let largest = other.iter().map(|r| r.dissipation).fold(0.0, f64::max);
+    let (mut geometry, mut dissipation) = (0.0_f64, 0.0_f64);
+    for (r, s) in one.iter().zip(other) {
+        assert_eq!((r.step, r.phase, r.regime), (s.step, s.phase, s.regime));
+        let a = s.half_width;
+        for (x, y) in [
+            (r.stick_lo, s.stick_lo),
+            (r.stick_hi, s.stick_hi),
+            (r.half_width, s.half_width),
+            (r.eccentricity, s.eccentricity),
+            (r.displacement, s.displacement),
+        ] {
+            geometry = geometry.max((x - y).abs() / a);
+        }
+        dissipation = dissipation.max((r.dissipation - s.dissipation).abs() / largest);
+    }
+    (geometry, dissipation)
+}
+
+/// Residual evaluations of a run's steps.
+fn evaluations(records: &[fretsim::history::StepRecord]) -> usize {
+    records.iter().map(|r| r.newton_iterations).sum()
+}
+
 /// The state after ramping Q from 0 to `fraction` ηP in steps of 0.1 ηP (at least
 /// `steps_per_segment`) from the end of normal loading.
 fn ramped_state(
@@ -1338,51 +1394,19 @@ fn pipelined_history_matches_sequential_steps() {
 #[test]
 fn recalled_cycles_repeat_the_solved_ones() {
     use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{LoadHistory, NoObserver, run_history};
     let b = baseline(32);
-    let history = LoadHistory {
-        points: half_amplitude_cycles(b.lim, 7),
-        steps_per_segment: 10,
-        max_step: 0.05 * b.lim,
-    };
     let run = |recall: bool| {
         let options = SlipOptions {
             recall,
             ..SlipOptions::default()
         };
-        run_history(
-            &b.model,
-            &b.disc,
-            &b.normal,
-            &history,
-            options,
-            &mut NoObserver,
-        )
-        .unwrap()
-        .records
+        default_cycles(&b, options)
     };
     let (recalled, solved) = (run(true), run(false));
-    assert_eq!(recalled.len(), solved.len());
-    let evaluations = |recs: &[fretsim::history::StepRecord]| -> usize {
-        recs.iter().map(|r| r.newton_iterations).sum()
-    };
     let (with, without) = (evaluations(&recalled), evaluations(&solved));
     assert!(with * 10 < without * 7, "{with} against {without}");
-    let largest = solved.iter().map(|r| r.dissipation).fold(0.0, f64::max);
-    let (mut geometry, mut dissipation) = (0.0_f64, 0.0_f64);
+    let (geometry, dissipation) = record_differences(&recalled, &solved);
     for (r, s) in recalled.iter().zip(&solved) {
-        assert_eq!((r.step, r.phase, r.regime), (s.step, s.phase, s.regime));
-        let a = s.half_width;
-        for (x, y) in [
-            (r.stick_lo, s.stick_lo),
-            (r.stick_hi, s.stick_hi),
-            (r.half_width, s.half_width),
-            (r.eccentricity, s.eccentricity),
-            (r.displacement, s.displacement),
-        ] {
-            geometry = geometry.max((x - y).abs() / a);
-        }
-        dissipation = dissipation.max((r.dissipation - s.dissipation).abs() / largest);
         // Phases 5 and 6 (forward 3, reverse 3) are recalled whole, one evaluation a step.
         if r.phase >= 5 {
             assert_eq!(r.newton_iterations, 1, "step {}", r.step);
@@ -1404,54 +1428,20 @@ fn recalled_cycles_repeat_the_solved_ones() {
 #[test]
 fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
     use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{LoadHistory, NoObserver, run_history};
     let b = baseline(64);
     assert!(b.disc.coarse().is_some());
-    let history = LoadHistory {
-        points: half_amplitude_cycles(b.lim, 7),
-        steps_per_segment: 10,
-        max_step: 0.05 * b.lim,
-    };
     let run = |coarse_jacobian: bool| {
         let options = SlipOptions {
             coarse_jacobian,
             ..SlipOptions::default()
         };
-        run_history(
-            &b.model,
-            &b.disc,
-            &b.normal,
-            &history,
-            options,
-            &mut NoObserver,
-        )
-        .unwrap()
-        .records
+        default_cycles(&b, options)
     };
     let (coarse, carried) = (run(true), run(false));
-    assert_eq!(coarse.len(), carried.len());
-    let evaluations = |recs: &[fretsim::history::StepRecord]| -> usize {
-        recs.iter().map(|r| r.newton_iterations).sum()
-    };
     let (with, without) = (evaluations(&coarse), evaluations(&carried));
     println!("evaluations {with} against {without}");
     assert!(with * 10 < without * 9, "{with} against {without}");
-    let largest = carried.iter().map(|r| r.dissipation).fold(0.0, f64::max);
-    let (mut geometry, mut dissipation) = (0.0_f64, 0.0_f64);
-    for (r, s) in coarse.iter().zip(&carried) {
-        assert_eq!((r.step, r.phase, r.regime), (s.step, s.phase, s.regime));
-        let a = s.half_width;
-        for (x, y) in [
-            (r.stick_lo, s.stick_lo),
-            (r.stick_hi, s.stick_hi),
-            (r.half_width, s.half_width),
-            (r.eccentricity, s.eccentricity),
-            (r.displacement, s.displacement),
-        ] {
-            geometry = geometry.max((x - y).abs() / a);
-        }
-        dissipation = dissipation.max((r.dissipation - s.dissipation).abs() / largest);
-    }
+    let (geometry, dissipation) = record_differences(&coarse, &carried);
     println!("geometry {geometry:e}, dissipation {dissipation:e}");
     assert!(geometry < 1e-12, "{geometry:e}");
     assert!(dissipation < 1e-11, "{dissipation:e}");
