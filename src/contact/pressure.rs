@@ -35,14 +35,14 @@ pub struct Discretisation {
     /// collocation points, then at the unbounded ones (2M rows): the pressure at the points
     /// where the tangential solver samples the shear traction.
     pub bounded_at_collocation: RowMatrix,
-    /// The coarse companion grid ([`COARSE_NODES`] nodes, when M is at least twice that), on
-    /// which the tangential solver builds the finite-difference Jacobian of a step.
+    /// The coarse companion grid ([`COARSE_NODES`] nodes, when M is at least three times
+    /// that), on which the tangential solver builds the finite-difference Jacobian of a step.
     coarse: Option<Box<Discretisation>>,
 }
 
 /// Nodes of the coarse companion grid ([`Discretisation::coarse`]). Its Jacobian of a
-/// tangential step is within about 1 % of the fine grid's (the coarse grid's own
-/// discretisation error, which does not shrink between 16 and 48 nodes), and the five
+/// tangential step is within 1–3 % of the fine grid's (the two grids' discretisation errors
+/// of the derivatives, which do not shrink between 16 and 48 coarse nodes), and the five
 /// residual evaluations of its Jacobian cost about as much as half of one at M = 128. Of 16,
 /// 24 and 32 nodes, 24 made the forward step fastest (16 and 24 at M = 64, 96 and 256, all
 /// three at M = 128; `docs/performance.md`).
@@ -73,7 +73,7 @@ impl Discretisation {
             unit_psi,
             unit_integral,
             bounded_at_collocation,
-            coarse: (m >= 2 * COARSE_NODES).then(|| Box::new(Discretisation::new(COARSE_NODES))),
+            coarse: (m >= 3 * COARSE_NODES).then(|| Box::new(Discretisation::new(COARSE_NODES))),
         }
     }
 
@@ -82,8 +82,10 @@ impl Discretisation {
         self.bounded.len()
     }
 
-    /// The coarse companion grid, when M is at least twice [`COARSE_NODES`] (on a grid not much
-    /// finer, its evaluations would cost about as much as the fine ones they save).
+    /// The coarse companion grid, when M is at least three times [`COARSE_NODES`]: on a finer
+    /// grid its Jacobian saves time, on a coarser one its evaluations cost as much as the
+    /// fine ones they save (a forward step's state at M = 64 took 1.93 ms with it against
+    /// 1.90 ms without, at M = 80 2.22 against 2.57 ms, at M = 96 2.61 against 2.87 ms).
     pub fn coarse(&self) -> Option<&Discretisation> {
         self.coarse.as_deref()
     }

@@ -1420,15 +1420,16 @@ fn recalled_cycles_repeat_the_solved_ones() {
 
 /// Within a phase a step starts from the coarse grid's finite-difference Jacobian
 /// (`SlipOptions::coarse_jacobian`) instead of the one carried from the previous step: the
-/// default history (M = 64, steps of 0.05 ηP) through three ±½ ηP cycles, with and without.
-/// The states are the same to the solver's tolerance and the steps take fewer residual
-/// evaluations. Measured: 561 against 674 evaluations (bound nine tenths); the records differ
-/// by at most 1.4e−13 a in the geometry and δ and 8.4e−13 of the largest step dissipation
-/// (the solver's tolerance; bounds 1e−12 a and 1e−11, as for recalled steps).
+/// default history (M = 96, the coarsest grid with a coarse companion being 72, steps of
+/// 0.05 ηP) through three ±½ ηP cycles, with and without. The states are the same to the
+/// solver's tolerance and the steps take fewer residual evaluations. Measured: 542 against 654
+/// evaluations (bound nine tenths); the records differ by at most 1.1e−13 a in the geometry
+/// and δ and 1.8e−12 of the largest step dissipation (the solver's tolerance; bounds 1e−12 a
+/// and 1e−11, as for recalled steps).
 #[test]
 fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
     use fretsim::contact::tangential::SlipOptions;
-    let b = baseline(64);
+    let b = baseline(96);
     assert!(b.disc.coarse().is_some());
     let run = |coarse_jacobian: bool| {
         let options = SlipOptions {
