@@ -42,10 +42,9 @@ pub struct Discretisation {
 
 /// Nodes of the coarse companion grid ([`Discretisation::coarse`]). Its Jacobian of a
 /// tangential step is within 1–3 % of the fine grid's (the two grids' discretisation errors
-/// of the derivatives, which do not shrink between 16 and 48 coarse nodes), and the five
-/// residual evaluations of its Jacobian cost about as much as half of one at M = 128. Of 16,
-/// 24 and 32 nodes, 24 made the forward step fastest (16 and 24 at M = 64, 96 and 256, all
-/// three at M = 128; `docs/performance.md`).
+/// of the derivatives, which do not shrink between 16 and 48 coarse nodes). Of 16, 24 and 32
+/// nodes, 24 made the forward step fastest (16 and 24 at M = 96 and 256, all three at
+/// M = 128; `docs/performance.md`).
 pub const COARSE_NODES: usize = 24;
 
 impl Discretisation {

@@ -1541,9 +1541,9 @@ fn fd_jacobian(
 /// default history at M = 72 … 512; the test `coarse_jacobian_is_near_the_fine_one` bounds
 /// it), where the Jacobian carried from the previous step and updated by Broyden is off by
 /// 3–8 % (the fine Jacobian itself moves by 7–9 % from one step to the next, and the
-/// quasi-Newton steps, nearly parallel, correct it along one direction only). Its five evaluations (the base
-/// point at the full inner tolerance, from `guess`'s traction, and four differences) cost
-/// about half of one at M = 128.
+/// quasi-Newton steps, nearly parallel, correct it along one direction only). Its five
+/// evaluations: the base point at the full inner tolerance, from `guess`'s traction, and four
+/// differences.
 fn coarse_jacobian(
     problem: &StepProblem<'_>,
     g: &Geometry,
@@ -1612,9 +1612,9 @@ enum Method<'a> {
 /// from the coarse grid or from `hint` (the previous step's, when the sign pattern is the
 /// same; see [`Method::Broyden`]) or by finite differences, updated after every accepted
 /// step, and recomputed by finite differences only when a quasi-Newton direction fails the
-/// line search. The iteration begins with the
-/// stick ends `guess` and the half-width, centre and traction of `from`; `start` is the
-/// previous step, against which the slip direction is checked.
+/// line search. The iteration begins with the stick ends `guess` and the half-width, centre
+/// and traction of `from`; `start` is the previous step, against which the slip direction is
+/// checked.
 #[allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 fn solve_geometry(
     problem: &StepProblem<'_>,
