@@ -1675,9 +1675,10 @@ fn solve_geometry(
     // Within a phase the coarse grid's Jacobian at the first iterate replaces the carried one
     // (`coarse_jacobian`). Its evaluations are not counted: they are the coarse grid's.
     // Measured, the forward step at 0.35 ηP of the default history: 8 → 6 residual
-    // evaluations at M = 128, the residual 3.5e−4 → 1.5e−6 in the first iteration instead of
-    // 1.7e−5. At a phase start the fine one is kept (the coarse one there changed which of two
-    // admissible states some steps of the regression batch reached).
+    // evaluations at M = 128, the residual 3.5e−4 → 6.8e−7 in the first iteration instead of
+    // 1.7e−5. At a phase start the fine one is kept: tried there with a coarse grid at
+    // M = 64, the coarse one changed which admissible state three runs of the regression
+    // batch reached (`docs/performance.md`, thirteenth session).
     if options.coarse_jacobian && matches!(method, Method::Broyden(Some(_))) {
         jac = coarse_jacobian(problem, &g, &state).or(jac);
     }
