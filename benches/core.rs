@@ -94,7 +94,14 @@ fn bench_step(c: &mut Criterion, name: &str, sizes: &[usize], loads: &[f64], nex
 /// Time the state of one step to `next` ηP from the state after `loads`, without the
 /// increments (δ, dissipation, δn), which `run_history` computes on a second thread while it
 /// solves the next step.
-fn bench_state(c: &mut Criterion, name: &str, sizes: &[usize], loads: &[f64], next: f64) {
+fn bench_state(
+    c: &mut Criterion,
+    name: &str,
+    sizes: &[usize],
+    loads: &[f64],
+    next: f64,
+    options: SlipOptions,
+) {
     let sc = default_scenario();
     let mut g = c.benchmark_group(name);
     g.sample_size(10);
@@ -110,9 +117,7 @@ fn bench_state(c: &mut Criterion, name: &str, sizes: &[usize], loads: &[f64], ne
         g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
             b.iter(|| {
                 let mut d = driver.clone();
-                black_box(
-                    solve_step(&sc.model, &disc, &mut d, point, SlipOptions::default()).is_ok(),
-                )
+                black_box(solve_step(&sc.model, &disc, &mut d, point, options).is_ok())
             })
         });
     }
@@ -123,7 +128,30 @@ fn steps(c: &mut Criterion) {
     // In the middle of the first forward phase.
     let loads = [0.1, 0.2, 0.3];
     bench_step(c, "solve/forward_step", &SIZES, &loads, 0.35);
-    bench_state(c, "solve/forward_step_state_only", &SIZES, &loads, 0.35);
+    let options = SlipOptions::default();
+    bench_state(
+        c,
+        "solve/forward_step_state_only",
+        &SIZES,
+        &loads,
+        0.35,
+        options,
+    );
+    // The same without the coarse grid's Jacobian (`SlipOptions::coarse_jacobian`), on the
+    // grids that have one: the comparison under the same host load.
+    let carried = SlipOptions {
+        coarse_jacobian: false,
+        ..options
+    };
+    let sizes = [128, 256, 512];
+    bench_state(
+        c,
+        "solve/forward_step_state_carried_jacobian",
+        &sizes,
+        &loads,
+        0.35,
+        carried,
+    );
 }
 
 fn recalled(c: &mut Criterion) {
@@ -140,6 +168,7 @@ fn recalled(c: &mut Criterion) {
         &SIZES,
         &loads,
         0.35,
+        SlipOptions::default(),
     );
 }
 
