@@ -261,6 +261,23 @@ struct Geometry {
     c: f64,
 }
 
+impl Geometry {
+    /// A state's geometry (`None` without a stick zone).
+    fn of(state: &ContactState) -> Option<Self> {
+        let zone = state.traction.stick.as_ref()?;
+        Some(Self {
+            lo: zone.lo,
+            hi: zone.hi,
+            a: state.half_width,
+            c: state.centre,
+        })
+    }
+
+    fn values(&self) -> [f64; 4] {
+        [self.lo, self.hi, self.a, self.c]
+    }
+}
+
 /// Everything a step needs besides the geometry.
 struct StepProblem<'a> {
     model: &'a ContactModel,
@@ -1261,11 +1278,11 @@ pub struct Recalled {
 impl Recalled {
     /// The recalled admissibility, when geometry `g` is the recalled state's to the bit.
     fn repeated_at(&self, g: &Geometry) -> Option<StepAdmissibility> {
-        let s = &self.state;
-        let zone = s.traction.stick.as_ref()?;
-        let same = [g.lo, g.hi, g.a, g.c]
+        let recalled = Geometry::of(&self.state)?;
+        let same = g
+            .values()
             .iter()
-            .zip([zone.lo, zone.hi, s.half_width, s.centre])
+            .zip(recalled.values())
             .all(|(x, y)| x.to_bits() == y.to_bits());
         self.admissibility.filter(|_| same)
     }
@@ -2034,17 +2051,7 @@ mod tests {
         let normal =
             solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
         let state = Arc::new(normal.state);
-        let zone = state
-            .traction
-            .stick
-            .as_ref()
-            .expect("frictional normal loading");
-        let g = Geometry {
-            lo: zone.lo,
-            hi: zone.hi,
-            a: state.half_width,
-            c: state.centre,
-        };
+        let g = Geometry::of(&state).expect("frictional normal loading");
         let checks = StepAdmissibility {
             stick_excess: -0.25,
             ..StepAdmissibility::default()
@@ -2140,13 +2147,7 @@ mod tests {
             // The fine Jacobian at the state the driver has reached, and the step's problem.
             let at_state = |driver: &DriverState| {
                 let state = &driver.state;
-                let zone = state.traction.stick.as_ref().expect("slip state");
-                let g = Geometry {
-                    lo: zone.lo,
-                    hi: zone.hi,
-                    a: state.half_width,
-                    c: state.centre,
-                };
+                let g = Geometry::of(state).expect("slip state");
                 let problem = StepProblem {
                     model: &sc.model,
                     disc: &disc,
