@@ -658,7 +658,7 @@ impl Inherited {
     }
 
     /// [`Self::cauchy`] at each of `xs` into `out` (bit-identical: the points whose χ picks
-    /// the same node list share one pass over it in SIMD lanes, [`FadeSums`], each point's
+    /// the same node list share one pass over it in SIMD lanes, `FadeSums`, each point's
     /// terms summed in the same order; a skipped node adds −0, which leaves any sum
     /// unchanged; the test `batched_fields_equal_the_one_point_fields` compares the bits).
     pub fn cauchy_into(&self, xs: &[f64], out: &mut Vec<f64>) {
@@ -771,10 +771,15 @@ pub fn kink_cauchy(u: f64) -> f64 {
 /// five points made steps worse than leaving the remembered kink to the series.
 const FADE_POINTS: f64 = 6.0;
 
-/// Points whose Chebyshev sums a zone's own part interleaves ([`StickZone::own_parts_into`]):
-/// the Clenshaw recurrences are latency-bound, and eight independent chains instead of four
-/// made the first-loading step at M = 128 5 % faster (2.60–2.63 against 2.74–2.76 ms, best of
-/// 300 in four interleaved rounds; 16 chains 2.59–2.62 ms) and M = 64 4 %, with the same bits.
+/// Points whose Chebyshev sums are interleaved in the batched evaluations of a zone's own part
+/// ([`StickZone::own_parts_into`]) and of the contact's series
+/// ([`ContactState::pressures_into`] and the like): the Clenshaw recurrences are
+/// latency-bound, and eight independent points instead of four made the first-loading step at
+/// M = 128 5 % faster for the zones (2.60–2.63 against 2.74–2.76 ms, best of 300 in four
+/// interleaved rounds; 16 points 2.59–2.62 ms) and 2.5 % more for the contact's series
+/// (2.55–2.57 ms), with the same bits. (Eight rows at a time in
+/// [`crate::quadrature::RowMatrix::fill_recurrence_rows`] instead of four was slower, 2.66
+/// against 2.62 ms.)
 const OWN_LANES: usize = 8;
 
 /// A zone's own part in one form (density or Cauchy transform): the series at
@@ -893,8 +898,8 @@ impl StickZone {
     }
 
     /// [`Self::correction_at`] at each of `xs` into `out` (bit-identical; the own series is
-    /// summed [`OWN_LANES`] points at a time, [`BoundedSeries::densities`], and the chain in
-    /// batches).
+    /// summed eight (`OWN_LANES`) points at a time, [`BoundedSeries::densities`], and the
+    /// chain in batches).
     pub fn corrections_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         if let Some(table) = self.value_table.0.get() {
             table.values_into(xs, |_| 0.0, out);
@@ -965,7 +970,7 @@ impl StickZone {
     }
 
     /// [`Self::correction_cauchy`] at each of `xs` into `out` (bit-identical; the own series
-    /// [`OWN_LANES`] points at a time, [`BoundedSeries::cauchys`], and the chain's fade
+    /// eight (`OWN_LANES`) points at a time, [`BoundedSeries::cauchys`], and the chain's fade
     /// integrals in batches, [`Inherited::cauchy_into`]).
     pub fn correction_cauchys_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         out.clear();
@@ -1306,18 +1311,19 @@ impl ContactState {
     }
 
     /// A series in the contact variable τ plus `extra(x)` at each of `xs` into `out`: the
-    /// series four points at a time by `four`, which must give `one`'s values bit for bit.
+    /// series [`OWN_LANES`] points at a time by `many`, which must give `one`'s values bit for
+    /// bit.
     fn contact_series_into(
         &self,
         xs: &[f64],
-        four: impl Fn([f64; 4]) -> [f64; 4],
+        many: impl Fn([f64; OWN_LANES]) -> [f64; OWN_LANES],
         one: impl Fn(f64) -> f64,
         extra: impl Fn(f64) -> f64,
         out: &mut Vec<f64>,
     ) {
         in_chunks(
             xs,
-            |x| four(x.map(|x| self.tau(x))),
+            |x| many(x.map(|x| self.tau(x))),
             |x| one(self.tau(x)),
             out,
         );
@@ -1326,8 +1332,8 @@ impl ContactState {
         }
     }
 
-    /// [`Self::pressure_at`] at each of `xs` into `out` (bit-identical, the series four points
-    /// at a time).
+    /// [`Self::pressure_at`] at each of `xs` into `out` (bit-identical, the series
+    /// eight (`OWN_LANES`) points at a time).
     pub fn pressures_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         let (series, kinks) = (&self.pressure, &self.pressure_kinks);
         let four = |t| series.densities(t);
