@@ -418,10 +418,11 @@ impl FadeTable {
 }
 
 /// [`fade_sum`] at each point `x` (with χ there `cx`) into `sums` (which start at −0), the
-/// points in SIMD lanes of whatever width the processor offers (`pulp`'s run-time dispatch:
-/// AVX2 halves the time of the divisions that bound these sums). Each lane adds the same
-/// terms in the same order as [`fade_sum`], a skipped node −0, so the sums are its own to
-/// the bit on every processor.
+/// points in SIMD lanes chosen at run time by `pulp` (four-wide AVX2 where the processor has
+/// it, else two-wide SSE2: the 256-bit divisions that bound these sums halve their time;
+/// points left over from the lanes by [`fade_sum`] itself). Each lane adds the same terms in
+/// the same order as [`fade_sum`], a skipped node −0, so the sums are its own to the bit on
+/// every processor.
 struct FadeSums<'a> {
     nodes: &'a [(f64, f64, f64)],
     x: &'a [f64],
