@@ -155,6 +155,25 @@ fn record_differences(
 }
 
 /// Residual evaluations of a run's steps.
+/// [`default_cycles`] with one option of the default [`SlipOptions`] switched on by `set`,
+/// and with it switched off.
+///
+/// [`SlipOptions`]: fretsim::contact::tangential::SlipOptions
+fn with_and_without(
+    b: &Baseline,
+    set: impl Fn(&mut fretsim::contact::tangential::SlipOptions, bool),
+) -> (
+    Vec<fretsim::history::StepRecord>,
+    Vec<fretsim::history::StepRecord>,
+) {
+    let run = |on: bool| {
+        let mut options = fretsim::contact::tangential::SlipOptions::default();
+        set(&mut options, on);
+        default_cycles(b, options)
+    };
+    (run(true), run(false))
+}
+
 fn evaluations(records: &[fretsim::history::StepRecord]) -> usize {
     records.iter().map(|r| r.newton_iterations).sum()
 }
@@ -1393,16 +1412,8 @@ fn pipelined_history_matches_sequential_steps() {
 /// residual gate and is solved afresh (more evaluations).
 #[test]
 fn recalled_cycles_repeat_the_solved_ones() {
-    use fretsim::contact::tangential::SlipOptions;
     let b = baseline(32);
-    let run = |recall: bool| {
-        let options = SlipOptions {
-            recall,
-            ..SlipOptions::default()
-        };
-        default_cycles(&b, options)
-    };
-    let (recalled, solved) = (run(true), run(false));
+    let (recalled, solved) = with_and_without(&b, |o, on| o.recall = on);
     let (with, without) = (evaluations(&recalled), evaluations(&solved));
     assert!(with * 10 < without * 7, "{with} against {without}");
     let (geometry, dissipation) = record_differences(&recalled, &solved);
@@ -1428,17 +1439,9 @@ fn recalled_cycles_repeat_the_solved_ones() {
 /// and 1e−11, as for recalled steps).
 #[test]
 fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
-    use fretsim::contact::tangential::SlipOptions;
     let b = baseline(96);
     assert!(b.disc.coarse().is_some());
-    let run = |coarse_jacobian: bool| {
-        let options = SlipOptions {
-            coarse_jacobian,
-            ..SlipOptions::default()
-        };
-        default_cycles(&b, options)
-    };
-    let (coarse, carried) = (run(true), run(false));
+    let (coarse, carried) = with_and_without(&b, |o, on| o.coarse_jacobian = on);
     let (with, without) = (evaluations(&coarse), evaluations(&carried));
     println!("evaluations {with} against {without}");
     assert!(with * 10 < without * 9, "{with} against {without}");
