@@ -60,7 +60,7 @@ use crate::contact::memory::Memory;
 use crate::contact::normal::NormalLoading;
 use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::{
-    Recalled, SlipOptions, SlipStep, StepAdmissibility, WarmStart, solve_slip,
+    PhaseStart, Recalled, SlipOptions, SlipStep, StepAdmissibility, WarmStart, solve_slip,
 };
 use crate::contact::{ContactModel, ContactState};
 use crate::error::{Issue, SolveFailure};
@@ -323,6 +323,8 @@ pub struct DriverState {
     /// The steps of the current phase, and of the last finished phase of each direction
     /// (reverse, forward): a later phase that begins from the same turning state recalls them.
     traces: Traces,
+    /// How the last phase began, when with mixed slip signs ([`PhaseStart`]).
+    last_start: Option<PhaseStart>,
 }
 
 /// The accepted steps of one phase ([`Recalled`]).
@@ -473,6 +475,7 @@ impl DriverState {
             warm: None,
             first_centre_slope: None,
             traces: Traces::default(),
+            last_start: None,
         }
     }
 }
@@ -867,6 +870,7 @@ pub fn solve_step(
             driver.warm.as_ref()
         },
         recalled.as_ref(),
+        driver.last_start.as_ref().filter(|_| new_phase),
         options,
     )
     .map_err(|failure| StepFailure {
@@ -877,6 +881,7 @@ pub fn solve_step(
         failure,
     })?;
     if new_phase {
+        driver.last_start = PhaseStart::of(&solved.state, sign);
         driver.first_centre_slope = Some((solved.state.centre - c) / dq);
         driver.phase += 1;
         driver.phase_start_load = start_load;
