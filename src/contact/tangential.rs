@@ -1931,77 +1931,6 @@ fn solve_geometry(
     })
 }
 
-/// A slip zone of a state: the one left of its stick zone or the one right of it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Side {
-    Left,
-    Right,
-}
-
-impl Side {
-    /// The slip sign of this side's zone.
-    fn sign_of(self, state: &ContactState) -> f64 {
-        match self {
-            Side::Left => state.traction.left_sign,
-            Side::Right => state.traction.right_sign,
-        }
-    }
-}
-
-/// The frictional work density per unit η, `p Δs` (module docs, Checks), at the points a
-/// fraction `fractions` of the way from the stick end of `side`'s slip zone to its contact end
-/// (the inner of the two states' ends): the slip increment is the running integral of the
-/// strain change from the stick end, by graded quadrature split at every point where either
-/// state is not smooth (`breaks`, [`super::step_breakpoints`]) and at the points. Half the
-/// nodes of `slip_zone_rule_nodes` per balanced piece give the slips to 1.2e−6 of the largest
-/// (measured over the default history at M = 64 … 512 against four times the nodes).
-fn slip_works(
-    model: &ContactModel,
-    old: &ContactState,
-    new: &ContactState,
-    breaks: &[f64],
-    side: Side,
-    fractions: &[f64],
-) -> Vec<(f64, f64)> {
-    let stick = new.traction.stick.as_ref().expect("slip state");
-    let (c, a) = (new.centre, new.half_width);
-    let (from, to) = match side {
-        Side::Right => (stick.hi, (c + a).min(old.centre + old.half_width)),
-        Side::Left => (stick.lo, (c - a).max(old.centre - old.half_width)),
-    };
-    let mut d_strain =
-        |xs: &[f64], out: &mut Vec<f64>| new.strain_changes_into(model, old, xs, out);
-    let samples: Vec<f64> = fractions.iter().map(|f| from + f * (to - from)).collect();
-    let (left, right) = (from.min(to), from.max(to));
-    let mut pts: Vec<f64> = breaks
-        .iter()
-        .copied()
-        .filter(|x| *x > left && *x < right)
-        .collect();
-    pts.extend(&samples);
-    pts.extend([left, right]);
-    let nodes = super::slip_zone_rule_nodes(new.pressure.beta.len()) / 2;
-    let table = super::graded_cumulative(pts, nodes, &mut d_strain);
-    samples
-        .into_iter()
-        .map(|x| {
-            // ∫ from `left` to x: the nodes of the pieces before x (x is a piece end).
-            let before: f64 = table
-                .nodes
-                .iter()
-                .filter(|n| n.0 < x)
-                .map(|n| n.1 * n.2)
-                .sum();
-            let slip = if to > from {
-                before
-            } else {
-                before - table.total
-            };
-            (x, slip * new.pressure_at(x))
-        })
-        .collect()
-}
-
 fn check(adm: &StepAdmissibility, tol: f64) -> Result<(), SolveFailure> {
     let [stick_at, slip_at, pressure_at] = adm.worst_at;
     super::first_violation(&[
@@ -2077,22 +2006,60 @@ pub fn assess_step(
             out.worst_at[0] = x;
         }
     }
-    // The frictional work at points of each slip zone (`slip_works`), up to the inner of the
-    // two contact ends (points that enter or leave the contact have no slip increment); the
-    // quadrature's 1.2e−6 of the largest is far inside the check's tolerance of 1e−2.
+    // Slip increments at points of each slip zone: the running integral of the strain change
+    // from the stick end, by graded quadrature split at every point where either state is not
+    // smooth ([`super::step_breakpoints`]), up to the inner of the two contact ends (points
+    // that enter or leave the contact have no slip increment). Half the nodes of
+    // `slip_zone_rule_nodes` per balanced piece give the slips to 1.2e−6 of the largest
+    // (measured over the default history at M = 64 … 512 against four times the nodes), far
+    // inside the check's tolerance of 1e−2.
+    let mut d_strain =
+        |xs: &[f64], out: &mut Vec<f64>| new.strain_changes_into(model, old, xs, out);
     let breaks = super::step_breakpoints(old, new);
     let mut slips = Vec::new();
-    for side in [Side::Right, Side::Left] {
-        let zone_sign = side.sign_of(new);
-        let works = slip_works(
-            model,
-            old,
-            new,
-            &breaks,
-            side,
-            &[0.25, 0.5, 0.75, 0.9, 0.97, 1.0],
-        );
-        slips.extend(works.into_iter().map(|(x, w)| (x, zone_sign, w)));
+    let zones = [
+        (
+            stick.hi,
+            (c + a).min(old.centre + old.half_width),
+            new.traction.right_sign,
+        ),
+        (
+            stick.lo,
+            (c - a).max(old.centre - old.half_width),
+            new.traction.left_sign,
+        ),
+    ];
+    for (from, to, zone_sign) in zones {
+        let samples: Vec<f64> = [0.25, 0.5, 0.75, 0.9, 0.97, 1.0]
+            .iter()
+            .map(|f| from + f * (to - from))
+            .collect();
+        let (left, right) = (from.min(to), from.max(to));
+        let mut pts: Vec<f64> = breaks
+            .iter()
+            .copied()
+            .filter(|x| *x > left && *x < right)
+            .collect();
+        pts.extend(&samples);
+        pts.extend([left, right]);
+        let nodes = super::slip_zone_rule_nodes(new.pressure.beta.len()) / 2;
+        let table = super::graded_cumulative(pts, nodes, &mut d_strain);
+        for x in samples {
+            // ∫ from `left` to x: the nodes of the pieces before x (x is a piece end).
+            let before: f64 = table
+                .nodes
+                .iter()
+                .filter(|n| n.0 < x)
+                .map(|n| n.1 * n.2)
+                .sum();
+            let slip = if to > from {
+                before
+            } else {
+                before - table.total
+            };
+            // The frictional work density per unit η (module docs, Checks).
+            slips.push((x, zone_sign, slip * new.pressure_at(x)));
+        }
     }
     let largest = slips
         .iter()
