@@ -323,7 +323,7 @@ pub struct DriverState {
     /// The steps of the current phase, and of the last finished phase of each direction
     /// (reverse, forward): a later phase that begins from the same turning state recalls them.
     traces: Traces,
-    /// How the last phase began, when with mixed slip signs ([`PhaseStart`]).
+    /// How the last phase that began with mixed slip signs began ([`PhaseStart`]).
     last_start: Option<PhaseStart>,
 }
 
@@ -881,7 +881,9 @@ pub fn solve_step(
         failure,
     })?;
     if new_phase {
-        driver.last_start = PhaseStart::of(&solved.state, sign);
+        if let Some(start) = PhaseStart::of(&solved.state, sign) {
+            driver.last_start = Some(start);
+        }
         driver.first_centre_slope = Some((solved.state.centre - c) / dq);
         driver.phase += 1;
         driver.phase_start_load = start_load;

@@ -112,9 +112,9 @@
 //! - Right after a reversal in a coupled contact the contact shifts, and one edge may keep its
 //!   old slip direction for a while: states with slip signs `(−s, s)` and `(s, −s)` are tried
 //!   when `(s, s)` has no solution. The edge that keeps its old direction slips over a thin
-//!   zone (1.6e−3 a at the first reversal of the default history), so a phase start whose
-//!   predecessor began mixed tries that pattern first, with that end as far from its contact
-//!   end as it was then ([`PhaseStart`]).
+//!   zone (1.6e−3 a at the first reversal of the default history), so after a phase that
+//!   began mixed, a phase start tries that pattern (after the standard one) with that end as
+//!   far from its contact end as it was then ([`PhaseStart`]).
 //! - Stick ends can jump when the load passes an earlier turning point (Masing memory) or when
 //!   a plateau of the traction reaches the friction limit: the earlier stick/slip boundaries of
 //!   the memory are tried as starting points.
@@ -201,11 +201,12 @@ pub struct SlipOptions {
     /// carried from the previous step (where the grid has a coarse companion). The states are
     /// the same to the tolerance; the steps take fewer residual evaluations.
     pub coarse_jacobian: bool,
-    /// At a phase start, try first the mixed slip pattern that began the last phase, from its
-    /// stick end next to the edge that slipped against the phase ([`PhaseStart`]; the history
-    /// driver keeps it). The states are the same to the tolerance; the later reversals of a
-    /// coupled contact skip the standard pattern's inadmissible state and start near their own.
-    pub repeat_mixed_start: bool,
+    /// At a phase start, try the mixed slip pattern that began the last phase that began mixed
+    /// (after the standard pattern's attempts, before the other mixed ones), from its stick end
+    /// next to the edge that slipped against the phase ([`PhaseStart`]; the history driver
+    /// keeps it). The states are the same to the tolerance; the later reversals of a coupled
+    /// contact start their mixed attempt near their own state.
+    pub mixed_start_guesses: bool,
 }
 
 impl Default for SlipOptions {
@@ -218,7 +219,7 @@ impl Default for SlipOptions {
             stall_tolerance: 1e-4,
             recall: true,
             coarse_jacobian: true,
-            repeat_mixed_start: true,
+            mixed_start_guesses: true,
         }
     }
 }
@@ -1267,18 +1268,24 @@ pub struct WarmStart {
     pub jacobian: [[f64; 4]; 4],
 }
 
-/// How the last phase began when its first step had mixed slip signs (one edge kept its old
-/// slip direction while the contact shifted, module docs): the signs, and the distance of the
+/// How the last phase that began with mixed slip signs began (one edge kept its old slip
+/// direction while the contact shifted, module docs): the signs, and the distance of the
 /// stick end next to the edge that slipped against the phase from that contact end, relative
-/// to the half-width. The next phase start tries that pattern first ([`solve_slip`]), from the
-/// standard guess with the end next to the edge that slips against the new phase (the other
-/// edge, when the direction is the other one) moved to the same distance from its contact end.
+/// to the half-width. A later phase start tries that pattern ([`solve_slip`]) after the
+/// standard pattern's attempts and before the other mixed ones, from the standard guess with
+/// the end next to the edge that slips against the new phase (the other edge, when the
+/// direction is the other one) moved to the same distance from its contact end.
+///
+/// The standard pattern keeps going first: where both converge to states that pass the checks
+/// (an edge zone thinner than the checks resolve), the standard one is the state reported, as
+/// without this guess (a PZT-4 history 0 → 0.2 → 0.6 → −0.2 → 0.4 ηP at M = 64: at −0.2 ηP the
+/// mixed pattern tried first gave a state 1e−2 a away in one stick end, which also passes).
+///
 /// Measured on the default history at M = 128: at the first step after the turning point at
 /// +½ηP the standard pattern converges to a state that fails the slip check (11 evaluations),
 /// and the mixed one, from the standard guess 1.0e−2 a inside the left contact end while its
 /// solution lies 1.6e−3 a inside, takes 20 evaluations; the two later reversals solved afresh
-/// (at −½ηP and +½ηP) took 11 evaluations each from that distance, against 31 and 21 (and the
-/// standard pattern's 11 before them).
+/// (at −½ηP and +½ηP) took 11 evaluations each from that distance, against 31 and 21.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PhaseStart {
     /// Slip signs of the left and right slip zones.
@@ -1357,8 +1364,9 @@ impl Recalled {
 /// correction chain `base`. `contact`, when given, is the predicted contact half-width and
 /// centre `(a, c)` from which the attempts with the first stick-zone guess start (otherwise
 /// they start from `start`'s). `recalled`, when given, is tried first (see [`Recalled`]);
-/// `last_start`, at a phase start, is how the last phase began: its mixed pattern is then
-/// tried before the standard one ([`PhaseStart`], [`SlipOptions::repeat_mixed_start`]).
+/// `last_start`, at a phase start, is how the last phase that began mixed began: its pattern
+/// is then tried after the standard one's attempts and before the other mixed ones, from its
+/// remembered edge ([`PhaseStart`], [`SlipOptions::mixed_start_guesses`]).
 #[allow(clippy::too_many_arguments)]
 pub fn solve_slip(
     model: &ContactModel,
@@ -1443,15 +1451,24 @@ pub fn solve_slip(
             }
         }
     }
-    // At a phase start, the mixed pattern that began the last phase first, its stick end next
-    // to the edge that slips against the phase where it was then (`PhaseStart`).
+    // At a phase start, the mixed pattern that began the last phase is tried first among the
+    // attempts of its signs, with its stick end next to the edge that slips against the phase
+    // where it was then (`PhaseStart`). The standard pattern's attempts still come first: where
+    // both converge to states that pass the checks (the edge zone thinner than what the checks
+    // resolve), the standard one is the state the step reports.
     let preferred = last_start
-        .filter(|_| warm.is_none() && options.repeat_mixed_start)
+        .filter(|_| warm.is_none() && options.mixed_start_guesses)
         .map(|last| {
             let from = contact.unwrap_or((start.half_width, start.centre));
             (last.signs, last.guess(sign, guess, from))
         });
-    plan.splice(0..0, preferred);
+    if let Some(entry) = preferred {
+        let at = plan
+            .iter()
+            .position(|p| p.0 == entry.0)
+            .unwrap_or(plan.len());
+        plan.insert(at, entry);
+    }
     let mut attempts = Attempts::default();
     let scratch = LentMaps::lend();
     let problem_for = |signs: (f64, f64)| StepProblem {
