@@ -176,7 +176,8 @@ fn reversal(c: &mut Criterion) {
     // The first step after the turning point at +½ηP.
     bench_step(c, "solve/reversal_step", &SIZES, &default_loads(0), 0.45);
     // The first step after the next turning point, at −½ηP: it begins in the mixed slip
-    // pattern that began the phase before (`SlipOptions::repeat_mixed_start`).
+    // pattern that began the phase before, whose attempt starts from that phase's edge
+    // (`SlipOptions::mixed_start_guesses`).
     let mut loads = default_loads(0);
     loads.extend((1..=20).map(|i| 0.5 - 0.05 * i as f64));
     bench_step(c, "solve/later_reversal_step", &SIZES, &loads, -0.45);
