@@ -164,7 +164,19 @@ fn record_differences(
     (geometry, dissipation)
 }
 
-/// Residual evaluations of a run's steps.
+/// Two runs of the same steps reached the same states to the solver's tolerance: the
+/// geometry and δ within 1e−12 a, the step dissipations within 1e−11 of the largest
+/// ([`record_differences`]).
+fn assert_same_states(
+    one: &[fretsim::history::StepRecord],
+    other: &[fretsim::history::StepRecord],
+) {
+    let (geometry, dissipation) = record_differences(one, other);
+    println!("geometry {geometry:e}, dissipation {dissipation:e}");
+    assert!(geometry < 1e-12, "{geometry:e}");
+    assert!(dissipation < 1e-11, "{dissipation:e}");
+}
+
 /// [`default_cycles`] with one option of the default [`SlipOptions`] switched on by `set`,
 /// and with it switched off.
 ///
@@ -184,6 +196,7 @@ fn with_and_without(
     (run(true), run(false))
 }
 
+/// Residual evaluations of a run's steps.
 fn evaluations(records: &[fretsim::history::StepRecord]) -> usize {
     records.iter().map(|r| r.newton_iterations).sum()
 }
@@ -1426,7 +1439,7 @@ fn recalled_cycles_repeat_the_solved_ones() {
     let (recalled, solved) = with_and_without(&b, |o, on| o.recall = on);
     let (with, without) = (evaluations(&recalled), evaluations(&solved));
     assert!(with * 10 < without * 7, "{with} against {without}");
-    let (geometry, dissipation) = record_differences(&recalled, &solved);
+    assert_same_states(&recalled, &solved);
     for (r, s) in recalled.iter().zip(&solved) {
         // Phases 5 and 6 (forward 3, reverse 3) are recalled whole, one evaluation a step.
         if r.phase >= 5 {
@@ -1435,8 +1448,6 @@ fn recalled_cycles_repeat_the_solved_ones() {
             assert_eq!(r.newton_iterations, s.newton_iterations, "step {}", r.step);
         }
     }
-    assert!(geometry < 1e-12, "{geometry:e}");
-    assert!(dissipation < 1e-11, "{dissipation:e}");
 }
 
 /// Within a phase a step starts from the coarse grid's finite-difference Jacobian
@@ -1455,10 +1466,7 @@ fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
     let (with, without) = (evaluations(&coarse), evaluations(&carried));
     println!("evaluations {with} against {without}");
     assert!(with * 10 < without * 9, "{with} against {without}");
-    let (geometry, dissipation) = record_differences(&coarse, &carried);
-    println!("geometry {geometry:e}, dissipation {dissipation:e}");
-    assert!(geometry < 1e-12, "{geometry:e}");
-    assert!(dissipation < 1e-11, "{dissipation:e}");
+    assert_same_states(&coarse, &carried);
 }
 
 /// A phase start tries the mixed slip pattern that began the last phase, from its stick end
@@ -1497,10 +1505,7 @@ fn later_reversals_start_from_the_last_mixed_pattern() {
             assert!(h.newton_iterations < p.newton_iterations, "phase {phase}");
         }
     }
-    let (geometry, dissipation) = record_differences(&hinted, &plain);
-    println!("geometry {geometry:e}, dissipation {dissipation:e}");
-    assert!(geometry < 1e-12, "{geometry:e}");
-    assert!(dissipation < 1e-11, "{dissipation:e}");
+    assert_same_states(&hinted, &plain);
 }
 
 /// Where the standard pattern passes the checks at a phase start, it is the state the step
@@ -1553,10 +1558,7 @@ fn phase_starts_keep_the_standard_pattern_where_it_passes() {
         let same = (h.left_slip_sign, h.right_slip_sign) == (p.left_slip_sign, p.right_slip_sign);
         assert!(same, "step {}", h.step);
     }
-    let (geometry, dissipation) = record_differences(&hinted, &plain);
-    println!("geometry {geometry:e}, dissipation {dissipation:e}");
-    assert!(geometry < 1e-12, "{geometry:e}");
-    assert!(dissipation < 1e-11, "{dissipation:e}");
+    assert_same_states(&hinted, &plain);
     let mixed: Vec<_> = starts
         .iter()
         .filter(|(h, _)| h.left_slip_sign != h.right_slip_sign)
