@@ -198,8 +198,10 @@ pub struct SlipOptions {
     pub recall: bool,
     /// Within a phase, start each attempt from the finite-difference Jacobian of the coarse
     /// companion grid ([`Discretisation::coarse`]) at its first iterate instead of the one
-    /// carried from the previous step (where the grid has a coarse companion). The states are
-    /// the same to the tolerance; the steps take fewer residual evaluations.
+    /// carried from the previous step, or, for slip signs other than the previous step's,
+    /// instead of a fine finite-difference one (where the grid has a coarse companion). The
+    /// states are the same to the tolerance; the steps take fewer residual evaluations (the
+    /// second step of a phase that began mixed, M = 128: 8 instead of 11).
     pub coarse_jacobian: bool,
     /// At a phase start, try the mixed slip pattern that began the last phase that began mixed
     /// (after the standard pattern's attempts, before the other mixed ones), from its stick end
@@ -1495,10 +1497,11 @@ pub fn solve_slip(
                 break 'attempts;
             }
             let problem = problem_for(signs);
-            let method = if newton {
-                Method::Newton
-            } else {
-                Method::Broyden(warm.filter(|w| w.signs == signs).map(|w| w.jacobian))
+            let method = match warm {
+                _ if newton => Method::Newton,
+                Some(w) if w.signs == signs => Method::Broyden(Some(w.jacobian)),
+                Some(_) => Method::Coarse,
+                None => Method::Broyden(None),
             };
             // Within a phase the prediction continues the warm start's slip signs only.
             let first = guess == guesses_in[0] || preferred == Some((signs, guess));
@@ -1506,8 +1509,8 @@ pub fn solve_slip(
             match solve_geometry(&problem, start, start, (guess, contact), method, options) {
                 Ok(step) => return Ok(step),
                 Err(failed) => {
-                    let retry =
-                        failed.stalled.is_some() && matches!(method, Method::Broyden(Some(_)));
+                    let retry = failed.stalled.is_some()
+                        && matches!(method, Method::Broyden(Some(_)) | Method::Coarse);
                     attempts.record(failed);
                     // A stall from a carried (or coarse) Jacobian is tried once more from a
                     // fresh finite-difference one before the stalled iterate is taken (default
@@ -1709,6 +1712,10 @@ enum Method<'a> {
     /// step's) or, with [`SlipOptions::coarse_jacobian`] and a coarse grid, from the coarse
     /// grid's at the first iterate; without one, from a finite-difference Jacobian.
     Broyden(Option<[[f64; 4]; 4]>),
+    /// Broyden's updates within a phase for slip signs other than the previous step's (whose
+    /// Jacobian does not apply): from the coarse grid's Jacobian at the first iterate with
+    /// [`SlipOptions::coarse_jacobian`] and a coarse grid, else a finite-difference one.
+    Coarse,
     /// Newton's method with a finite-difference Jacobian at every iterate and five times the
     /// evaluation budget: slower, and the fallback where the quasi-Newton attempts all fail.
     Newton,
@@ -1736,6 +1743,7 @@ fn solve_geometry(
 ) -> Result<SlipStep, Failed> {
     let (hint, broyden) = match method {
         Method::Broyden(hint) => (hint, true),
+        Method::Coarse => (None, true),
         Method::Recall(recalled) => (Some(recalled.warm.jacobian), true),
         Method::Newton => (None, false),
     };
@@ -1789,7 +1797,7 @@ fn solve_geometry(
     // 1.7e−5. At a phase start the fine one is kept: tried there with a coarse grid at
     // M = 64, the coarse one changed which admissible state three runs of the regression
     // batch reached (`docs/performance.md`, thirteenth session).
-    if options.coarse_jacobian && matches!(method, Method::Broyden(Some(_))) {
+    if options.coarse_jacobian && matches!(method, Method::Broyden(Some(_)) | Method::Coarse) {
         jac = coarse_jacobian(problem, &g, &state).or(jac);
     }
     let mut fresh = false;
