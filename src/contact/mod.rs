@@ -1337,26 +1337,26 @@ impl ContactState {
     /// eight (`OWN_LANES`) points at a time).
     pub fn pressures_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         let (series, kinks) = (&self.pressure, &self.pressure_kinks);
-        let four = |t| series.densities(t);
+        let many = |t| series.densities(t);
         let one = |t| series.density(t);
-        self.contact_series_into(xs, four, one, |x| self.kinks_at(kinks, x), out);
+        self.contact_series_into(xs, many, one, |x| self.kinks_at(kinks, x), out);
     }
 
     /// [`Self::potential_charge_at`] at each of `xs` into `out` (bit-identical).
     pub fn potential_charges_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         let (series, kinks) = (&self.potential_charge, &self.charge_kinks);
-        let four = |t| series.densities(t);
+        let many = |t| series.densities(t);
         let one = |t| series.density(t);
-        self.contact_series_into(xs, four, one, |x| self.kinks_at(kinks, x), out);
+        self.contact_series_into(xs, many, one, |x| self.kinks_at(kinks, x), out);
     }
 
     /// [`Self::pressure_cauchy`] at each of `xs` into `out` (bit-identical).
     pub fn pressure_cauchys_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         let (series, kinks) = (&self.pressure, &self.pressure_kinks);
-        let four = |t| series.cauchys(t);
+        let many = |t| series.cauchys(t);
         let one = |t| series.cauchy(t);
         let extra = |x| self.kinks_with(kinks, |u, v| half_ellipse_cauchy(x, u, v));
-        self.contact_series_into(xs, four, one, extra, out);
+        self.contact_series_into(xs, many, one, extra, out);
     }
 
     /// [`Self::traction_at`] at each of `xs` into `out` (bit-identical, in batches).

@@ -1453,8 +1453,8 @@ pub fn solve_slip(
             }
         }
     }
-    // At a phase start, the mixed pattern that began the last phase is tried first among the
-    // attempts of its signs, with its stick end next to the edge that slips against the phase
+    // At a phase start, the pattern of the last phase that began mixed is tried first among
+    // the attempts of its signs, with its stick end next to the edge that slips against the phase
     // where it was then (`PhaseStart`). The standard pattern's attempts still come first: where
     // both converge to states that pass the checks (the edge zone thinner than what the checks
     // resolve), the standard one is the state the step reports.

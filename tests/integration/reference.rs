@@ -103,13 +103,10 @@ fn half_amplitude_cycles(limit: f64, turns: usize) -> Vec<(f64, f64)> {
     points
 }
 
-/// The default history (three ±½ ηP cycles in steps of 0.05 ηP) on `b`'s grid with
-/// `options`: its step records.
-fn default_cycles(
-    b: &Baseline,
-    options: fretsim::contact::tangential::SlipOptions,
-) -> Vec<fretsim::history::StepRecord> {
-    records_of(b, half_amplitude_cycles(b.lim, 7), options)
+/// The default history's load points on `b`'s grid: three ±½ ηP cycles after the first
+/// loading.
+fn default_points(b: &Baseline) -> Vec<(f64, f64)> {
+    half_amplitude_cycles(b.lim, 7)
 }
 
 /// The step records of the history through `points` in steps of at most 0.05 ηP (ten a
@@ -177,12 +174,13 @@ fn assert_same_states(
     assert!(dissipation < 1e-11, "{dissipation:e}");
 }
 
-/// [`default_cycles`] with one option of the default [`SlipOptions`] switched on by `set`,
-/// and with it switched off.
+/// The records of the history through `points` ([`records_of`]) with one option of the
+/// default [`SlipOptions`] switched on by `set`, and with it switched off.
 ///
 /// [`SlipOptions`]: fretsim::contact::tangential::SlipOptions
 fn with_and_without(
     b: &Baseline,
+    points: Vec<(f64, f64)>,
     set: impl Fn(&mut fretsim::contact::tangential::SlipOptions, bool),
 ) -> (
     Vec<fretsim::history::StepRecord>,
@@ -191,9 +189,22 @@ fn with_and_without(
     let run = |on: bool| {
         let mut options = fretsim::contact::tangential::SlipOptions::default();
         set(&mut options, on);
-        default_cycles(b, options)
+        records_of(b, points.clone(), options)
     };
     (run(true), run(false))
+}
+
+/// The `k`-th step (from 0) of phase `phase`.
+fn phase_step(
+    records: &[fretsim::history::StepRecord],
+    phase: usize,
+    k: usize,
+) -> &fretsim::history::StepRecord {
+    records
+        .iter()
+        .filter(|r| r.phase == phase)
+        .nth(k)
+        .expect("the phase has the step")
 }
 
 /// Residual evaluations of a run's steps.
@@ -1436,7 +1447,7 @@ fn pipelined_history_matches_sequential_steps() {
 #[test]
 fn recalled_cycles_repeat_the_solved_ones() {
     let b = baseline(32);
-    let (recalled, solved) = with_and_without(&b, |o, on| o.recall = on);
+    let (recalled, solved) = with_and_without(&b, default_points(&b), |o, on| o.recall = on);
     let (with, without) = (evaluations(&recalled), evaluations(&solved));
     assert!(with * 10 < without * 7, "{with} against {without}");
     assert_same_states(&recalled, &solved);
@@ -1464,7 +1475,8 @@ fn recalled_cycles_repeat_the_solved_ones() {
 fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
     let b = baseline(96);
     assert!(b.disc.coarse().is_some());
-    let (coarse, carried) = with_and_without(&b, |o, on| o.coarse_jacobian = on);
+    let (coarse, carried) =
+        with_and_without(&b, default_points(&b), |o, on| o.coarse_jacobian = on);
     let (with, without) = (evaluations(&coarse), evaluations(&carried));
     println!("evaluations {with} against {without}");
     assert!(with * 10 < without * 9, "{with} against {without}");
@@ -1472,20 +1484,15 @@ fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
     // which the first step has no Jacobian: the coarse grid's replaces a fine
     // finite-difference one (four evaluations).
     for phase in 2..=4 {
-        let second = |records: &[fretsim::history::StepRecord]| {
-            records
-                .iter()
-                .filter(|r| r.phase == phase)
-                .nth(1)
-                .cloned()
-                .expect("two steps")
-        };
-        let (c, f) = (second(&coarse), second(&carried));
+        let (c, f) = (
+            phase_step(&coarse, phase, 1),
+            phase_step(&carried, phase, 1),
+        );
         println!(
             "phase {phase}, second step: evaluations {} against {}",
             c.newton_iterations, f.newton_iterations
         );
-        let first = coarse.iter().find(|r| r.phase == phase).expect("a step");
+        let first = phase_step(&coarse, phase, 0);
         assert_ne!(first.left_slip_sign, first.right_slip_sign, "phase {phase}");
         assert_eq!(c.left_slip_sign, c.right_slip_sign, "phase {phase}");
         assert!(c.newton_iterations < f.newton_iterations, "phase {phase}");
@@ -1505,16 +1512,10 @@ fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
 #[test]
 fn later_reversals_start_from_the_last_mixed_pattern() {
     let b = baseline(32);
-    let (hinted, plain) = with_and_without(&b, |o, on| o.mixed_start_guesses = on);
-    let first_of = |records: &[fretsim::history::StepRecord], phase: usize| {
-        records
-            .iter()
-            .find(|r| r.phase == phase)
-            .cloned()
-            .expect("phase reached")
-    };
+    let (hinted, plain) =
+        with_and_without(&b, default_points(&b), |o, on| o.mixed_start_guesses = on);
     for phase in 2..=4 {
-        let (h, p) = (first_of(&hinted, phase), first_of(&plain, phase));
+        let (h, p) = (phase_step(&hinted, phase, 0), phase_step(&plain, phase, 0));
         println!(
             "phase {phase}: signs ({}, {}), evaluations {} against {}",
             h.left_slip_sign, h.right_slip_sign, h.newton_iterations, p.newton_iterations
@@ -1552,18 +1553,11 @@ fn phase_starts_keep_the_standard_pattern_where_it_passes() {
         .enumerate()
         .map(|(k, f)| (k as f64, f * b.lim))
         .collect::<Vec<_>>();
-    let run = |on: bool| {
-        let options = fretsim::contact::tangential::SlipOptions {
-            mixed_start_guesses: on,
-            ..Default::default()
-        };
-        records_of(&b, points.clone(), options)
-    };
-    let (hinted, plain) = (run(true), run(false));
-    let starts: Vec<_> = hinted
-        .iter()
-        .zip(&plain)
-        .filter(|(h, _)| h.step > 1 && hinted[h.step - 1].phase != h.phase)
+    let (hinted, plain) = with_and_without(&b, points, |o, on| o.mixed_start_guesses = on);
+    // The first steps of the phases after the first loading's.
+    let phases = hinted.last().expect("steps").phase;
+    let starts: Vec<_> = (2..=phases)
+        .map(|phase| (phase_step(&hinted, phase, 0), phase_step(&plain, phase, 0)))
         .collect();
     for (h, p) in &starts {
         println!(
