@@ -473,6 +473,31 @@ fn assert_same_traction(out: &Path, pairs: &[(f64, f64)], tol: f64) {
     }
 }
 
+/// At each pair of snapshot times (s) the shear traction q of the field files agrees to the
+/// last of its ten printed significant digits: within one unit of that digit, which is where
+/// two states equal to the solver's tolerance may round apart.
+fn assert_same_traction_digits(out: &Path, pairs: &[(f64, f64)]) {
+    let file = |t: f64| out.join(format!("fields/t_{t:.6}.csv"));
+    for &(a, b) in pairs {
+        let (_, fa) = read_csv(&file(a));
+        let (_, fb) = read_csv(&file(b));
+        for (x, y) in fa.iter().zip(&fb) {
+            let (qa, qb) = (x[2], y[2]);
+            let largest = qa.abs().max(qb.abs());
+            let unit = if largest > 0.0 {
+                10f64.powf(largest.log10().floor() - 9.0)
+            } else {
+                0.0
+            };
+            assert!(
+                (qa - qb).abs() <= 1.5 * unit,
+                "{a} s vs {b} s at x = {}: {qa:e} against {qb:e}",
+                x[0]
+            );
+        }
+    }
+}
+
 /// Uncoupled Cattaneo–Mindlin contact, partial unload to 0.2ηP and reload to 0.6ηP: on
 /// reloading to the earlier maximum the memory of the unloading is wiped out
 /// (Mindlin–Deresiewicz), so the traction at t = 3 s is that at t = 1 s (measured identical to
@@ -561,7 +586,9 @@ fn scenario_variable_amplitude() {
 /// The same partial unload–reload on PZT-4 under a conducting punch: despite the
 /// shear–pressure and electric coupling, reloading to the earlier maximum returns to the state
 /// of the first loading (Masing's memory; the driver tries the remembered turning state), so
-/// the traction files agree to the last digit (measured difference 0).
+/// the traction files agree to the last digit (measured: identical, or two values a unit
+/// apart in their tenth digit, 1e−4 Pa of 1.4e6 and 6.7e6 Pa, depending on the round-off of
+/// the first loading's iterates).
 #[test]
 fn scenario_partial_unload_reload() {
     let (_tmp, out, s) = run_scenario("partial_unload_reload");
@@ -575,7 +602,7 @@ fn scenario_partial_unload_reload() {
             "forward_slip"
         ]
     );
-    assert_same_traction(&out, &[(1.0, 3.0)], 1e-12);
+    assert_same_traction_digits(&out, &[(1.0, 3.0)]);
 }
 
 #[test]

@@ -1500,6 +1500,25 @@ fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
     assert_same_states(&coarse, &carried);
 }
 
+/// Within a phase the Jacobian is updated by the projected secant update
+/// (`SlipOptions::projected_updates`) instead of Broyden's: the default history (M = 32, no
+/// coarse grid, so every step within a phase starts from the Jacobian carried from the
+/// previous one) through three ±½ ηP cycles, with and without. The states are the same to the
+/// solver's tolerance (bounds as for recalled steps) and the steps take fewer residual
+/// evaluations. Measured: 587 against 667 evaluations (bound nine tenths); the records differ by
+/// at most 9.5e−14 a in the geometry and δ and 1.4e−12 of the largest step dissipation.
+#[test]
+fn projected_updates_reach_the_same_states_in_fewer_evaluations() {
+    let b = baseline(32);
+    assert!(b.disc.coarse().is_none());
+    let (projected, broyden) =
+        with_and_without(&b, default_points(&b), |o, on| o.projected_updates = on);
+    let (with, without) = (evaluations(&projected), evaluations(&broyden));
+    println!("evaluations {with} against {without}");
+    assert!(with * 10 < without * 9, "{with} against {without}");
+    assert_same_states(&projected, &broyden);
+}
+
 /// A phase start tries the mixed slip pattern that began the last phase, from its stick end
 /// next to the edge that slipped against that phase (`SlipOptions::mixed_start_guesses`):
 /// the default history (M = 32) through three ±½ ηP cycles, with and without. The first
