@@ -2001,7 +2001,8 @@ fn secant_update(
 /// spoils the earlier secant conditions. Quasi-Newton steps within a phase are nearly
 /// parallel (mostly along the stick end that moves), so the update restarts, as Broyden's,
 /// when a step has less than a tenth of its length outside the earlier directions (or all
-/// four are taken).
+/// four are taken; over the regression batch, a restart below 0.01 / 0.03 / 0.1 / 0.3 / 0.5
+/// of the length took 8155 / 8077 / 8073 / 8384 / 8645 evaluations).
 ///
 /// Measured over the 17-run regression batch: residual evaluations 8859 → 8073, the states
 /// the same to the tolerance except at one step with two converged states 4.9e−5 a apart
