@@ -1994,7 +1994,7 @@ fn secant_update(
 }
 
 /// The directions of an attempt's accepted steps since its last restart, orthonormal: the
-/// projected secant update (Gay and Schnabel's) updates the Jacobian along the part of each
+/// projected secant update (Gay and Schnabel, 1978) updates the Jacobian along the part of each
 /// new step orthogonal to them, so that it keeps mapping the earlier steps to their changes
 /// of the residuals as well as the new one. On a linear problem the Jacobian is exact after
 /// four independent steps, where Broyden's update, which updates along the step itself,
@@ -2012,6 +2012,10 @@ fn secant_update(
 #[derive(Debug, Default)]
 struct SecantDirections(Vec<[f64; 4]>);
 
+/// The fraction of a step's length outside the earlier directions below which
+/// [`SecantDirections`] restarts.
+const RESTART_FRACTION: f64 = 0.1;
+
 impl SecantDirections {
     /// The direction of the update for `step`, which joins the directions.
     fn direction(&mut self, step: [f64; 4]) -> [f64; 4] {
@@ -2023,7 +2027,7 @@ impl SecantDirections {
             }
         }
         let length2 = |v: &[f64; 4]| v.iter().map(|x| x * x).sum::<f64>();
-        if length2(&rest) < 1e-2 * length2(&step) || self.0.len() == 4 {
+        if length2(&rest) < RESTART_FRACTION.powi(2) * length2(&step) || self.0.len() == 4 {
             self.0.clear();
             rest = step;
         }
@@ -2314,15 +2318,21 @@ mod tests {
         let fifth = [1.0, 1.0, 1.0, 1.0];
         assert_eq!(bits(directions.direction(fifth)), bits(fifth));
         assert_eq!(directions.0.len(), 1);
-        // A step with 4 % of its length outside the first direction restarts them too; one
-        // with 19 % does not.
+        // A step with 4 % of its length outside the one direction restarts them too; the next
+        // one, with 15 % outside the new direction, does not: its update is along that part.
         let near = [1.0, 1.0, 1.0, 1.1];
         assert_eq!(bits(directions.direction(near)), bits(near));
         let turned = directions.direction([1.0, 1.0, 1.0, 1.5]);
+        let along = (3.0 + 1.1 * 1.5) / (3.0 + 1.1 * 1.1);
+        let expected = [1.0 - along, 1.0 - along, 1.0 - along, 1.5 - 1.1 * along];
         assert!(
-            turned[0].abs() < 0.2 && directions.0.len() == 2,
+            turned
+                .iter()
+                .zip(expected)
+                .all(|(t, e)| (t - e).abs() < 1e-15),
             "{turned:?}"
         );
+        assert_eq!(directions.0.len(), 2);
     }
 
     /// A recalled step's checks are taken only at its geometry to the bit, and only when the
