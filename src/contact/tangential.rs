@@ -1517,8 +1517,7 @@ pub fn solve_slip(
             match solve_geometry(&problem, start, start, (guess, contact), method, options) {
                 Ok(step) => return Ok(step),
                 Err(failed) => {
-                    let retry = failed.stalled.is_some()
-                        && matches!(method, Method::Broyden(Some(_)) | Method::Coarse);
+                    let retry = failed.stalled.is_some() && method.within_phase();
                     attempts.record(failed);
                     // A stall from a carried (or coarse) Jacobian is tried once more from a
                     // fresh finite-difference one before the stalled iterate is taken (default
@@ -1716,24 +1715,34 @@ impl Attempts {
 /// How the geometry is iterated.
 #[derive(Debug, Clone, Copy)]
 enum Method<'a> {
-    /// Broyden's updates within the evaluation budget, from the given Jacobian (the previous
-    /// step's) or, with [`SlipOptions::coarse_jacobian`] and a coarse grid, from the coarse
+    /// Secant updates within the evaluation budget (projected within a phase, Broyden's at a
+    /// phase start: [`Method::within_phase`]), from the given Jacobian (the previous step's) or, with [`SlipOptions::coarse_jacobian`] and a coarse grid, from the coarse
     /// grid's at the first iterate; without one, from a finite-difference Jacobian.
     Broyden(Option<[[f64; 4]; 4]>),
-    /// Broyden's updates within a phase for slip signs other than the previous step's (whose
+    /// Secant updates within a phase for slip signs other than the previous step's (whose
     /// Jacobian does not apply): from the coarse grid's Jacobian at the first iterate with
     /// [`SlipOptions::coarse_jacobian`] and a coarse grid, else a finite-difference one.
     Coarse,
     /// Newton's method with a finite-difference Jacobian at every iterate and five times the
     /// evaluation budget: slower, and the fallback where the quasi-Newton attempts all fail.
     Newton,
-    /// Broyden's updates from a recalled step's Jacobian, the first residual solved at the full
+    /// Secant updates from a recalled step's Jacobian, the first residual solved at the full
     /// inner tolerance (from the recalled coefficients, a pass or two), and given up at once
     /// when that residual exceeds [`RECALL_RESIDUAL`].
     Recall(&'a Recalled),
 }
 
-/// Newton's method on the geometry with Broyden's rank-one updates: the Jacobian is taken
+impl Method<'_> {
+    /// Whether the attempt is within a phase and starts from a Jacobian that applies to its
+    /// slip signs or from the coarse grid's (not a phase start, not a recalled step, not
+    /// Newton's fallback): where the coarse grid's Jacobian is taken and a stall is tried once
+    /// more from a finite-difference one.
+    fn within_phase(&self) -> bool {
+        matches!(self, Method::Broyden(Some(_)) | Method::Coarse)
+    }
+}
+
+/// Newton's method on the geometry with rank-one secant updates: the Jacobian is taken
 /// from the coarse grid or from `hint` (the previous step's, when the sign pattern is the
 /// same; see [`Method::Broyden`]) or by finite differences, updated after every accepted
 /// step, and recomputed by finite differences only when a quasi-Newton direction fails the
@@ -1749,7 +1758,7 @@ fn solve_geometry(
     method: Method<'_>,
     options: SlipOptions,
 ) -> Result<SlipStep, Failed> {
-    let (hint, broyden) = match method {
+    let (hint, quasi_newton) = match method {
         Method::Broyden(hint) => (hint, true),
         Method::Coarse => (None, true),
         Method::Recall(recalled) => (Some(recalled.warm.jacobian), true),
@@ -1805,7 +1814,7 @@ fn solve_geometry(
     // 1.7e−5. At a phase start the fine one is kept: tried there with a coarse grid at
     // M = 64, the coarse one changed which admissible state three runs of the regression
     // batch reached (`docs/performance.md`, thirteenth session).
-    if options.coarse_jacobian && matches!(method, Method::Broyden(Some(_)) | Method::Coarse) {
+    if options.coarse_jacobian && method.within_phase() {
         jac = coarse_jacobian(problem, &g, &state).or(jac);
     }
     let mut fresh = false;
@@ -1859,11 +1868,8 @@ fn solve_geometry(
     // The projected update within a phase; at a phase start Broyden's (there the iteration's
     // path decides which of several admissible states it reaches: tried there too, the first
     // step of a PZT-4 first loading at M = 128 reached another state, 8e−5 a away).
-    let projected = options.projected_updates
-        && matches!(
-            method,
-            Method::Broyden(Some(_)) | Method::Coarse | Method::Recall(_)
-        );
+    let projected =
+        options.projected_updates && (method.within_phase() || matches!(method, Method::Recall(_)));
     let mut directions = SecantDirections::default();
     let mut iterations = 0;
     for iter in 0..options.max_iterations {
@@ -1887,7 +1893,7 @@ fn solve_geometry(
         // state after 38 more.
         let near = size < 1e4 * options.tolerance;
         let budget =
-            if broyden { 1 } else { 5 } * options.max_evaluations * if near { 2 } else { 1 };
+            if quasi_newton { 1 } else { 5 } * options.max_evaluations * if near { 2 } else { 1 };
         if evaluations > budget {
             break;
         }
@@ -1941,7 +1947,7 @@ fn solve_geometry(
             step
         };
         let change = std::array::from_fn(|i| rn[i] - r[i]);
-        jac = broyden.then(|| secant_update(j, step, change, direction));
+        jac = quasi_newton.then(|| secant_update(j, step, change, direction));
         fresh = false;
         g = gn;
         r = rn;
