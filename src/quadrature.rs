@@ -140,9 +140,24 @@ impl RowMatrix {
     /// `y = A x`.
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
         debug_assert_eq!(x.len(), self.cols);
-        for (i, yi) in y.iter_mut().enumerate() {
-            *yi = dot(self.row(i), x);
+        self.products(x, Out::Set(y));
+    }
+
+    /// The products of the first rows with `x` (as many as `out` has entries) into `out`, in
+    /// one SIMD dispatch for all of them.
+    fn products(&self, x: &[f64], out: Out) {
+        if self.cols == 0 {
+            if let Out::Set(y) = out {
+                y.fill(0.0);
+            }
+            return;
         }
+        pulp::Arch::new().dispatch(Dots {
+            rows: &self.data,
+            cols: self.cols,
+            x,
+            out,
+        });
     }
 
     /// `y += factor · A x`; nothing for a matrix without rows (an absent map).
@@ -151,9 +166,7 @@ impl RowMatrix {
             return;
         }
         debug_assert_eq!(x.len(), self.cols);
-        for (i, yi) in y.iter_mut().enumerate() {
-            *yi += factor * dot(self.row(i), x);
-        }
+        self.products(x, Out::Add(y, factor));
     }
 }
 
@@ -171,19 +184,87 @@ fn transform_times(transform: &[f64], m: usize, inverse: &Mat<f64>, rows: usize)
     out
 }
 
-/// `Σ a_i b_i` with four partial sums (which the compiler can keep in vector registers).
+/// `Σ a_i b_i` over the common length, in the SIMD lanes of the processor it runs on
+/// ([`simd_dot`]).
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len().min(b.len());
-    let (a4, b4) = (a[..n].chunks_exact(4), b[..n].chunks_exact(4));
-    let (ra, rb) = (a4.remainder(), b4.remainder());
-    let mut acc = [0.0; 4];
-    for (x, y) in a4.zip(b4) {
-        for k in 0..4 {
-            acc[k] += x[k] * y[k];
+    struct Dot<'a>(&'a [f64], &'a [f64]);
+    impl pulp::WithSimd for Dot<'_> {
+        type Output = f64;
+        #[inline(always)]
+        fn with_simd<S: pulp::Simd>(self, simd: S) -> f64 {
+            simd_dot(simd, self.0, self.1)
         }
     }
-    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
-    (acc[0] + acc[2]) + (acc[1] + acc[3]) + tail
+    pulp::Arch::new().dispatch(Dot(a, b))
+}
+
+/// `Σ a_i b_i` with four vector accumulators (sixteen lanes with AVX2, chosen at run time by
+/// `pulp`), fused multiply–adds where the processor has them. Four scalar partial sums were
+/// four chains of dependent additions, latency-bound: the products with the iteration's
+/// matrices took a quarter of a tangential step at M = 128 (`docs/performance.md`,
+/// seventeenth session). The accumulators are summed pairwise at the end, then the lanes,
+/// then the products left over from the lanes. The round-off therefore depends on the
+/// processor's lane width and on FMA; [`RowMatrix::apply`] gives each row's [`dot`] to the
+/// bit.
+#[inline(always)]
+fn simd_dot<S: pulp::Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a_lanes, a_tail) = S::as_simd_f64s(&a[..n]);
+    let (b_lanes, b_tail) = S::as_simd_f64s(&b[..n]);
+    let zero = simd.splat_f64s(0.0);
+    let mut acc = [zero; 4];
+    let (a4, b4) = (a_lanes.chunks_exact(4), b_lanes.chunks_exact(4));
+    let (a_rest, b_rest) = (a4.remainder(), b4.remainder());
+    for (x, y) in a4.zip(b4) {
+        for k in 0..4 {
+            acc[k] = simd.mul_add_e_f64s(x[k], y[k], acc[k]);
+        }
+    }
+    for (k, (x, y)) in a_rest.iter().zip(b_rest).enumerate() {
+        acc[k] = simd.mul_add_e_f64s(*x, *y, acc[k]);
+    }
+    let sum = simd.add_f64s(simd.add_f64s(acc[0], acc[2]), simd.add_f64s(acc[1], acc[3]));
+    let tail: f64 = a_tail.iter().zip(b_tail).map(|(x, y)| x * y).sum();
+    simd.reduce_sum_f64s(sum) + tail
+}
+
+/// Where [`Dots`] writes its row products.
+enum Out<'a> {
+    /// `y_i = row_i · x`.
+    Set(&'a mut [f64]),
+    /// `y_i += factor · row_i · x`.
+    Add(&'a mut [f64], f64),
+}
+
+/// The products of the rows of a row-major block (`cols` columns) with `x`, dispatched once
+/// for all rows ([`simd_dot`] inlined into the processor's SIMD instruction set).
+struct Dots<'a> {
+    rows: &'a [f64],
+    cols: usize,
+    x: &'a [f64],
+    out: Out<'a>,
+}
+
+impl pulp::WithSimd for Dots<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) {
+        let Self { rows, cols, x, out } = self;
+        let rows = rows.chunks_exact(cols);
+        match out {
+            Out::Set(y) => {
+                for (yi, row) in y.iter_mut().zip(rows) {
+                    *yi = simd_dot(simd, row, x);
+                }
+            }
+            Out::Add(y, factor) => {
+                for (yi, row) in y.iter_mut().zip(rows) {
+                    *yi += factor * simd_dot(simd, row, x);
+                }
+            }
+        }
+    }
 }
 
 /// Grid and factored collocation matrix for densities bounded at both ends.
@@ -292,9 +373,7 @@ impl BoundedGrid {
     /// precomputed matrix: writes β and returns λ.
     pub fn solve_coefficients(&self, rhs: &[f64], beta: &mut [f64]) -> f64 {
         debug_assert_eq!(rhs.len(), self.m + 1);
-        for (n, b) in beta.iter_mut().enumerate() {
-            *b = dot(self.solution.row(n), rhs);
-        }
+        self.solution.products(rhs, Out::Set(beta));
         dot(self.solution.row(self.m), rhs)
     }
 
@@ -739,6 +818,41 @@ pub fn gauss_legendre_cumulative(n: usize) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The SIMD products against plain sums, at lengths around the vector blocks (four
+    /// vectors of four lanes) and their left-over vectors and lanes: a product that dropped or
+    /// repeated a term would be off by that term, about 1/n of the sum.
+    #[test]
+    fn row_products_are_the_dot_products_of_the_rows() {
+        let value = |k: usize| ((k * 7919 % 104_729) as f64 / 104_729.0 - 0.5) * 3.0;
+        for cols in [0, 1, 3, 4, 5, 7, 8, 15, 16, 17, 19, 31, 33, 64, 65, 129] {
+            let rows = 5;
+            let mut a = RowMatrix::zeros(rows, cols);
+            for i in 0..rows {
+                for (j, v) in a.row_mut(i).iter_mut().enumerate() {
+                    *v = value(i * 1000 + j + 1);
+                }
+            }
+            let x: Vec<f64> = (0..cols).map(|j| value(50_000 + j)).collect();
+            let mut y = vec![f64::NAN; rows];
+            a.apply(&x, &mut y);
+            let mut z: Vec<f64> = (0..rows).map(|i| value(90_000 + i)).collect();
+            let before = z.clone();
+            a.add_apply(&x, 0.5, &mut z);
+            for i in 0..rows {
+                let terms: Vec<f64> = a.row(i).iter().zip(&x).map(|(p, q)| p * q).collect();
+                let plain: f64 = terms.iter().sum();
+                let size: f64 = terms.iter().map(|t| t.abs()).sum();
+                assert!(
+                    (y[i] - plain).abs() <= 1e-15 * size,
+                    "cols {cols}, row {i}: {} against {plain}",
+                    y[i]
+                );
+                assert_eq!(y[i].to_bits(), dot(a.row(i), &x).to_bits());
+                assert_eq!(z[i].to_bits(), (before[i] + 0.5 * y[i]).to_bits());
+            }
+        }
+    }
 
     #[test]
     fn cumulative_gauss_legendre_integrates_polynomials() {
