@@ -146,6 +146,11 @@ impl RowMatrix {
     /// The products of the first rows with `x` (as many as `out` has entries) into `out`, in
     /// one SIMD dispatch for all of them.
     fn products(&self, x: &[f64], out: Out) {
+        let (Out::Set(y) | Out::Add(y, _)) = &out;
+        debug_assert!(
+            self.cols == 0 || y.len() <= self.rows(),
+            "more outputs than rows"
+        );
         if self.cols == 0 {
             if let Out::Set(y) = out {
                 y.fill(0.0);
