@@ -1368,7 +1368,8 @@ pub fn analyse_cycles(
                 && records
                     .last()
                     .is_some_and(|r| r.regime == crate::history::Regime::ForwardSlip))
-            .then_some(records.len() - 1),
+            // Lazily: with no records `len() − 1` overflows (a panic in a debug build).
+            .then(|| records.len() - 1),
         )
         .collect();
     let mut rows: Vec<CycleRow> = Vec::new();
