@@ -190,7 +190,7 @@ fn transform_times(transform: &[f64], m: usize, inverse: &Mat<f64>, rows: usize)
 }
 
 /// `Σ a_i b_i` over the common length, in the SIMD lanes of the processor it runs on
-/// ([`simd_dot`]).
+/// (`simd_dot`).
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     struct Dot<'a>(&'a [f64], &'a [f64]);
     impl pulp::WithSimd for Dot<'_> {
@@ -999,7 +999,7 @@ mod tests {
     /// The many-point sums (in the processor's SIMD lanes) against the one-point sums, to the
     /// bit, at four points and at eight (the width of the contact's batches).
     #[test]
-    fn four_point_sums_equal_the_one_point_sums() {
+    fn many_point_sums_equal_the_one_point_sums() {
         fn check<const L: usize>(len: usize, tau: [f64; L]) {
             let beta: Vec<f64> = (0..len)
                 .map(|k| (0.7 * k as f64 + 0.3).sin() / (1.0 + k as f64))

@@ -1716,8 +1716,9 @@ impl Attempts {
 #[derive(Debug, Clone, Copy)]
 enum Method<'a> {
     /// Secant updates within the evaluation budget (projected within a phase, Broyden's at a
-    /// phase start: [`Method::within_phase`]), from the given Jacobian (the previous step's) or, with [`SlipOptions::coarse_jacobian`] and a coarse grid, from the coarse
-    /// grid's at the first iterate; without one, from a finite-difference Jacobian.
+    /// phase start: [`Method::within_phase`]), from the given Jacobian (the previous step's)
+    /// or, with [`SlipOptions::coarse_jacobian`] and a coarse grid, from the coarse grid's at
+    /// the first iterate; without one, from a finite-difference Jacobian.
     Broyden(Option<[[f64; 4]; 4]>),
     /// Secant updates within a phase for slip signs other than the previous step's (whose
     /// Jacobian does not apply): from the coarse grid's Jacobian at the first iterate with
