@@ -547,6 +547,7 @@ impl StepProblem<'_> {
         let mut crhs = vec![0.0; m.saturating_sub(1)];
         let mut work = vec![0.0; m + 1];
         let mut p_nodes = vec![0.0; maps.shape_nodes.rows()];
+        let (mut p_samples, mut own_samples) = (vec![0.0; np + nc], vec![0.0; np + nc]);
         // The kink terms' roots and amplitudes of p and w, refilled in each pass.
         let (mut roots, mut amp, mut w_amp) = (Vec::new(), Vec::new(), Vec::new());
         let scale = 1.0 / (model.radius * ystar);
@@ -635,12 +636,12 @@ impl StepProblem<'_> {
                 *r += f;
             }
             lambda_q = disc.bounded.solve_coefficients(&srhs, &mut beta_q);
+            // p and q̃'s own part at the sample points, each map's rows in one dispatch.
+            disc.bounded_at_collocation.apply(&beta_p, &mut p_samples);
+            kinks.at_samples.add_apply(&amp, 1.0, &mut p_samples);
+            maps.own_at_samples.apply(&beta_q, &mut own_samples);
             for (k, (shape, inh)) in fixed_p.iter().chain(&fixed_c).enumerate() {
-                let mut p = dot(disc.bounded_at_collocation.row(k), &beta_p);
-                if kinks.at_samples.rows() > 0 {
-                    p += dot(kinks.at_samples.row(k), &amp);
-                }
-                fx[k] = eta * p * shape + dot(maps.own_at_samples.row(k), &beta_q) + inh;
+                fx[k] = eta * p_samples[k] * shape + own_samples[k] + inh;
             }
             if coupled {
                 let [left, right] = probes.scaled_roots_of(&beta_q);
@@ -1052,23 +1053,23 @@ impl InnerMaps {
         // The stick points lie inside the contact, where `cauchy_row` is the T recurrence.
         let taus: Vec<f64> = stick_points.iter().map(|&xs| (xs - c) / a).collect();
         debug_assert!(taus.iter().all(|t| t.abs() < 1.0));
-        stick_from_p.refill_recurrence_rows(m, &taus, |t| {
-            let [prev, first, scale] = BoundedSeries::density_start(t);
-            [prev, first, k.local_over_y11 * scale]
-        });
-        cauchy_at_stick.refill_recurrence_rows(m, &taus, BoundedSeries::cauchy_start_inside);
         if let Some(eta_s) = k.shape {
-            for i in 0..rows {
-                for (o, r) in stick_from_p
-                    .row_mut(i)
-                    .iter_mut()
-                    .zip(cauchy_at_stick.row(i))
-                {
-                    *o -= eta_s * r;
-                }
-            }
-            // Folded into `stick_from_p`; mixed slip signs only keep it apart.
+            // `local √(1−τ²) U_{n−1}(τ) + η s T_n(τ)` (the density's term less η s times the
+            // Cauchy row `−T_n`, n = 1..M): U and T obey the same three-term recurrence, so
+            // their sum does, from `(η s, local √(1−τ²) + η s τ)` at n = 0 and 1. One fill
+            // instead of two and a fold (M = 128: the maps' rebuild about a third less).
+            stick_from_p.refill_recurrence_rows(m, &taus, |t| {
+                let [_, _, scale] = BoundedSeries::density_start(t);
+                [eta_s, k.local_over_y11 * scale + eta_s * t, 1.0]
+            });
+            // Mixed slip signs only keep the Cauchy rows apart.
             cauchy_at_stick.reset(0, m);
+        } else {
+            stick_from_p.refill_recurrence_rows(m, &taus, |t| {
+                let [prev, first, scale] = BoundedSeries::density_start(t);
+                [prev, first, k.local_over_y11 * scale]
+            });
+            cauchy_at_stick.refill_recurrence_rows(m, &taus, BoundedSeries::cauchy_start_inside);
         }
         if let Some(w13_over_y11) = k.charge {
             stick_from_w.refill_recurrence_rows(m, &taus, |t| {
