@@ -502,7 +502,8 @@ impl Inherited {
 
     fn table(&self) -> &FadeTable {
         self.table.get_or_init(|| {
-            let (nodes, weights) = graded_rule();
+            let rule = graded_rule_with(FADE_RULE_NODES);
+            let (nodes, weights) = (&rule.nodes, &rule.weights);
             let mut points = Vec::new();
             let mut scaled_weights = Vec::new();
             for w in self.pieces().windows(2) {
@@ -1694,6 +1695,20 @@ fn graded_rule_with(nodes: usize) -> &'static GradedRule {
 
 /// Nodes per piece of the graded rule of [`graded_rule`].
 const GRADED_NODES: usize = 96;
+
+/// Nodes per piece of the fade integral's graded rule ([`Inherited::cauchy`]), whose table is
+/// rebuilt at every residual evaluation (its pieces end at the fade ramps, which move with the
+/// stick ends). Measured on the regression batch of `docs/performance.md` against 192 nodes:
+/// 64 nodes move the stick ends by at most 1.5e−9 a at M = 128 and 1.4e−8 a at M = 256
+/// (the first loading, whose base zone carries the normal-loading centre kink), every other
+/// phase by at most 1e−8 a, and the histories' dissipation by at most 5e−9 of itself; 96 nodes
+/// (the other graded rules') 6.5e−9 a at M = 256 and 0 at M = 128. 48 nodes: 8e−8 a at
+/// M = 128 and 4e−7 a where a remembered stick end lies close to the new one; 32 nodes
+/// changed the dissipation of the insulating Figure-3 history by 7.6e−4. The stall of step 47
+/// of its η = 0.4 variant moves with any change of round-off and is left out of these figures.
+/// Against 96 nodes, the forward step at M = 128 takes about 8 % less (best of 400 in five
+/// interleaved rounds: 1.59–1.64 ms against 1.73–2.02 ms).
+const FADE_RULE_NODES: usize = 64;
 
 /// A sine-graded Gauss–Legendre rule on [−1, 1] (`u = sin(πv/2)`, see [`graded_rule`]) with
 /// its cumulative matrix.
