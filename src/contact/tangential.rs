@@ -1056,8 +1056,8 @@ impl InnerMaps {
         if let Some(eta_s) = k.shape {
             // `local √(1−τ²) U_{n−1}(τ) + η s T_n(τ)` (the density's term less η s times the
             // Cauchy row `−T_n`, n = 1..M): U and T obey the same three-term recurrence, so
-            // their sum does, from `(η s, local √(1−τ²) + η s τ)` at n = 0 and 1. One fill
-            // instead of two and a fold (M = 128: the maps' rebuild about a third less).
+            // their sum does, from `(η s, local √(1−τ²) + η s τ)` at n = 0 and 1. One sweep
+            // over the M × M rows instead of three (two fills and a fold).
             stick_from_p.refill_recurrence_rows(m, &taus, |t| {
                 let [_, _, scale] = BoundedSeries::density_start(t);
                 [eta_s, k.local_over_y11 * scale + eta_s * t, 1.0]
