@@ -573,15 +573,30 @@ impl Inherited {
     }
 
     /// [`Self::value`] at each of `xs` into `out` (bit-identical, the zone's values in a batch,
-    /// [`StickZone::corrections_into`]).
+    /// [`StickZone::corrections_into`], at the points where χ ≠ 0 only).
     pub fn values_into(&self, xs: &[f64], out: &mut Vec<f64>) {
-        self.zone.corrections_into(xs, out);
-        if self.faded() {
-            for (o, &x) in out.iter_mut().zip(xs) {
-                let chi = self.chi(x);
-                *o = if chi.abs() > 0.0 { chi * *o } else { 0.0 };
-            }
+        if !self.faded() {
+            self.zone.corrections_into(xs, out);
+            return;
         }
+        let chis: Vec<f64> = xs.iter().map(|&x| self.chi(x)).collect();
+        let points: Vec<f64> = xs
+            .iter()
+            .zip(&chis)
+            .filter(|(_, chi)| chi.abs() > 0.0)
+            .map(|(&x, _)| x)
+            .collect();
+        let mut values = Vec::with_capacity(points.len());
+        self.zone.corrections_into(&points, &mut values);
+        let mut values = values.into_iter();
+        out.clear();
+        out.extend(chis.iter().map(|&chi| {
+            if chi.abs() > 0.0 {
+                chi * values.next().expect("one value per point with χ ≠ 0")
+            } else {
+                0.0
+            }
+        }));
     }
 
     /// The remembered stick ends strictly inside `(lo, hi)` where this link's q̃ (with its
@@ -901,8 +916,31 @@ impl StickZone {
 
     /// [`Self::correction_at`] at each of `xs` into `out` (bit-identical; the own series is
     /// summed eight (`OWN_LANES`) points at a time, [`BoundedSeries::densities`], and the
-    /// chain in batches).
+    /// chain in batches). q̃ is zero outside the zone, so only the points inside are
+    /// evaluated (the slip zones' points of a step's checks and integrals, the sample points
+    /// beyond the stick ends).
     pub fn corrections_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        let inside = |x: f64| x > self.lo && x < self.hi;
+        if xs.iter().all(|&x| inside(x)) {
+            self.corrections_inside(xs, out);
+            return;
+        }
+        let points: Vec<f64> = xs.iter().copied().filter(|&x| inside(x)).collect();
+        let mut values = Vec::with_capacity(points.len());
+        self.corrections_inside(&points, &mut values);
+        let mut values = values.into_iter();
+        out.clear();
+        out.extend(xs.iter().map(|&x| {
+            if inside(x) {
+                values.next().expect("one value per point inside")
+            } else {
+                0.0
+            }
+        }));
+    }
+
+    /// [`Self::corrections_into`] at points that all lie inside the zone.
+    fn corrections_inside(&self, xs: &[f64], out: &mut Vec<f64>) {
         if let Some(table) = self.value_table.0.get() {
             table.values_into(xs, |_| 0.0, out);
             for (o, &x) in out.iter_mut().zip(xs) {
