@@ -1672,8 +1672,8 @@ pub fn slip_zone_rule_nodes(m: usize) -> usize {
 /// balanced (none more than three times as long as a neighbour, `piece_ends`), each piece by a
 /// `nodes`-point sine-graded Gauss–Legendre rule (nodes clustered like Chebyshev points at
 /// both ends, which absorbs square-root and logarithmic behaviour there: every point where f
-/// is not smooth must be among `points`). f is evaluated a piece's nodes at a time:
-/// `f(xs, out)` pushes the values at `xs` onto `out` (passed empty).
+/// is not smooth must be among `points`). f is evaluated at all the pieces' nodes in one
+/// call: `f(xs, out)` pushes the values at `xs` onto `out` (passed empty).
 pub fn graded_integral(points: Vec<f64>, nodes: usize, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> f64 {
     graded_rule_with(nodes).integral(points, f)
 }
@@ -1777,23 +1777,39 @@ impl GradedRule {
         }
     }
 
-    /// `∫ f` over the balanced pieces between `points` (see [`piece_ends`]).
-    fn integral(&self, points: Vec<f64>, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> f64 {
-        let (mut at, mut values) = (Vec::new(), Vec::new());
-        piece_ends(points)
+    /// The nodes of every balanced piece between `points` (see [`piece_ends`]), piece after
+    /// piece, with each piece's `(mid, half)`.
+    fn piece_nodes(&self, points: Vec<f64>) -> (Vec<(f64, f64)>, Vec<f64>) {
+        let pieces: Vec<(f64, f64)> = piece_ends(points)
             .windows(2)
-            .map(|w| {
-                let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-                at.clear();
-                at.extend(self.nodes.iter().map(|u| mid + half * u));
-                values.clear();
-                f(&at, &mut values);
-                let sum: f64 = self.weights.iter().zip(&values).map(|(wt, v)| wt * v).sum();
+            .map(|w| (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0])))
+            .collect();
+        let at = pieces
+            .iter()
+            .flat_map(|&(mid, half)| self.nodes.iter().map(move |u| mid + half * u))
+            .collect();
+        (pieces, at)
+    }
+
+    /// `∫ f` over the balanced pieces between `points` (see [`piece_ends`]). f is evaluated
+    /// at all the pieces' nodes in one call (its per-call work, such as an inherited zone's
+    /// grouping of the points, is then done once).
+    fn integral(&self, points: Vec<f64>, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> f64 {
+        let (pieces, at) = self.piece_nodes(points);
+        let mut values = Vec::with_capacity(at.len());
+        f(&at, &mut values);
+        pieces
+            .iter()
+            .zip(values.chunks_exact(self.nodes.len()))
+            .map(|(&(_, half), values)| {
+                let sum: f64 = self.weights.iter().zip(values).map(|(wt, v)| wt * v).sum();
                 half * sum
             })
             .sum()
     }
 
+    /// The running integral of f over the balanced pieces between `points` at every node,
+    /// f evaluated at all the nodes in one call (as [`Self::integral`]).
     fn cumulative(
         &self,
         points: Vec<f64>,
@@ -1801,18 +1817,14 @@ impl GradedRule {
     ) -> GradedTable {
         let (nodes, weights) = (&self.nodes, &self.weights);
         let n = nodes.len();
-        let points = piece_ends(points);
+        let (pieces, at) = self.piece_nodes(points);
+        let mut all = Vec::with_capacity(at.len());
+        f(&at, &mut all);
         let mut table = GradedTable::default();
-        let (mut at, mut values) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        for w in points.windows(2) {
-            let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-            at.clear();
-            at.extend(nodes.iter().map(|u| mid + half * u));
-            values.clear();
-            f(&at, &mut values);
+        for (&(mid, half), values) in pieces.iter().zip(all.chunks_exact(n)) {
             for k in 0..n {
                 let row = &self.cumulative[k * n..(k + 1) * n];
-                let before: f64 = half * row.iter().zip(&values).map(|(c, v)| c * v).sum::<f64>();
+                let before: f64 = half * row.iter().zip(values).map(|(c, v)| c * v).sum::<f64>();
                 table.nodes.push((
                     mid + half * nodes[k],
                     weights[k] * half,
@@ -1820,7 +1832,7 @@ impl GradedRule {
                     table.total + before,
                 ));
             }
-            table.total += half * weights.iter().zip(&values).map(|(w, v)| w * v).sum::<f64>();
+            table.total += half * weights.iter().zip(values).map(|(w, v)| w * v).sum::<f64>();
         }
         table
     }
