@@ -580,23 +580,9 @@ impl Inherited {
             return;
         }
         let chis: Vec<f64> = xs.iter().map(|&x| self.chi(x)).collect();
-        let points: Vec<f64> = xs
-            .iter()
-            .zip(&chis)
-            .filter(|(_, chi)| chi.abs() > 0.0)
-            .map(|(&x, _)| x)
-            .collect();
-        let mut values = Vec::with_capacity(points.len());
-        self.zone.corrections_into(&points, &mut values);
-        let mut values = values.into_iter();
-        out.clear();
-        out.extend(chis.iter().map(|&chi| {
-            if chi.abs() > 0.0 {
-                chi * values.next().expect("one value per point with χ ≠ 0")
-            } else {
-                0.0
-            }
-        }));
+        *out = faded(xs, &chis, |points, values| {
+            self.zone.corrections_into(points, values)
+        });
     }
 
     /// The remembered stick ends strictly inside `(lo, hi)` where this link's q̃ (with its
@@ -712,23 +698,10 @@ impl Inherited {
             }
         }
         // ... then χ H'q̃_E where χ ≠ 0, the zone's transform in one batch.
-        let inside: Vec<f64> = xs
-            .iter()
-            .zip(&chis)
-            .filter(|(_, c)| c.abs() > 0.0)
-            .map(|(&x, _)| x)
-            .collect();
-        let mut transforms = Vec::with_capacity(inside.len());
-        self.zone.correction_cauchys_into(&inside, &mut transforms);
-        let mut transforms = transforms.into_iter();
-        for (sum, &cx) in out.iter_mut().zip(&chis) {
-            let own = if cx.abs() > 0.0 {
-                cx * transforms
-                    .next()
-                    .expect("one transform per point with χ ≠ 0")
-            } else {
-                0.0
-            };
+        let own = faded(xs, &chis, |points, transforms| {
+            self.zone.correction_cauchys_into(points, transforms)
+        });
+        for (sum, own) in out.iter_mut().zip(own) {
             *sum = own + *sum / std::f64::consts::PI;
         }
     }
@@ -741,6 +714,29 @@ impl Inherited {
         // The fade table holds `w q̃_E` and χ on the same graded nodes.
         self.table().all.iter().map(|(_, wq, chi)| wq * chi).sum()
     }
+}
+
+/// `χ f` at each of `xs` (with χ there `chis`): `zone(points, out)`, a batch evaluation of
+/// the zone's part, is called once with the points where χ ≠ 0; elsewhere the value is zero.
+fn faded(xs: &[f64], chis: &[f64], zone: impl FnOnce(&[f64], &mut Vec<f64>)) -> Vec<f64> {
+    let points: Vec<f64> = xs
+        .iter()
+        .zip(chis)
+        .filter(|(_, chi)| chi.abs() > 0.0)
+        .map(|(&x, _)| x)
+        .collect();
+    let mut values = Vec::with_capacity(points.len());
+    zone(&points, &mut values);
+    let mut values = values.into_iter();
+    chis.iter()
+        .map(|&chi| {
+            if chi.abs() > 0.0 {
+                chi * values.next().expect("one value per point with χ ≠ 0")
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }
 
 /// A remembered stick end inside a new stick zone, where q̃ starts like a square root (the
