@@ -455,13 +455,17 @@ fn scenario_figure3_history_insulating() {
     assert!(rows.iter().all(|r| r[3] == 0.0));
 }
 
+/// The rows of the field files at two snapshot times (s).
+fn field_pair(out: &Path, a: f64, b: f64) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    let file = |t: f64| out.join(format!("fields/t_{t:.6}.csv"));
+    (read_csv(&file(a)).1, read_csv(&file(b)).1)
+}
+
 /// At each pair of snapshot times (s) the shear traction q of the field files is the same
 /// within `tol` of the peak pressure of the first.
 fn assert_same_traction(out: &Path, pairs: &[(f64, f64)], tol: f64) {
-    let file = |t: f64| out.join(format!("fields/t_{t:.6}.csv"));
     for &(a, b) in pairs {
-        let (_, fa) = read_csv(&file(a));
-        let (_, fb) = read_csv(&file(b));
+        let (fa, fb) = field_pair(out, a, b);
         let p0 = fa.iter().map(|r| r[1].abs()).fold(0.0, f64::max);
         let dq = fa
             .iter()
@@ -477,10 +481,8 @@ fn assert_same_traction(out: &Path, pairs: &[(f64, f64)], tol: f64) {
 /// last of its ten printed significant digits: within one unit of that digit, which is where
 /// two states equal to the solver's tolerance may round apart.
 fn assert_same_traction_digits(out: &Path, pairs: &[(f64, f64)]) {
-    let file = |t: f64| out.join(format!("fields/t_{t:.6}.csv"));
     for &(a, b) in pairs {
-        let (_, fa) = read_csv(&file(a));
-        let (_, fb) = read_csv(&file(b));
+        let (fa, fb) = field_pair(out, a, b);
         for (x, y) in fa.iter().zip(&fb) {
             let (qa, qb) = (x[2], y[2]);
             let largest = qa.abs().max(qb.abs());
