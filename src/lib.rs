@@ -39,7 +39,8 @@
 //! ## Modules
 //! - [`material`]: constants, presets, validation.
 //! - [`halfplane`]: surface compliance (extended Stroh formalism), the paper's f_ij, Δ1…Δ4.
-//! - [`quadrature`]: Gauss–Chebyshev grids, factored collocation matrices, Chebyshev series.
+//! - [`quadrature`]: Gauss–Chebyshev grids, factored collocation matrices, Chebyshev series;
+//!   [`transforms`]: the grids' cosine and sine sums by real FFTs.
 //! - [`contact`]: the contact model and state; [`contact::frictionless`] (Hertz, Zhou & Lee),
 //!   [`contact::normal`] (Spence's self-similar partial slip), [`contact::pressure`] (shared
 //!   pressure and charge sub-problems).
@@ -61,3 +62,4 @@ pub mod output;
 pub mod plot;
 pub mod quadrature;
 pub mod scenario;
+pub mod transforms;

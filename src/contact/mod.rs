@@ -791,7 +791,8 @@ const FADE_POINTS: f64 = 6.0;
 /// M = 128 5 % faster for the zones (2.60–2.63 against 2.74–2.76 ms, best of 300 in four
 /// interleaved rounds; 16 points 2.59–2.62 ms) and 2.5 % more for the contact's series
 /// (2.55–2.57 ms), with the same bits. (Eight rows at a time in
-/// [`crate::quadrature::RowMatrix::fill_recurrence_rows`] instead of four was slower, 2.66
+/// the row-major fill of the inner maps (since stored by columns,
+/// [`crate::quadrature::ColumnMatrix`]) instead of four was slower, 2.66
 /// against 2.62 ms.)
 const OWN_LANES: usize = 8;
 

@@ -17,7 +17,7 @@
 //! `(1/π)⨍ w(θ)/(θ − τ) dθ = −(w13/y33) q(c + aτ)`, `∫ w dx = Γ − kP`.
 
 use crate::error::SolveFailure;
-use crate::quadrature::{BoundedGrid, BoundedSeries, RowMatrix, UnboundedGrid, UnboundedSeries};
+use crate::quadrature::{BoundedGrid, BoundedSeries, UnboundedGrid, UnboundedSeries};
 
 use super::{ChargeSplit, ContactModel};
 
@@ -31,10 +31,6 @@ pub struct Discretisation {
     /// ψ₁: response to `−τ` (unit `1/(RY*)`), with its integral.
     unit_psi: Vec<f64>,
     unit_integral: f64,
-    /// Density rows ([`BoundedSeries::density_row`]) of a bounded series at the bounded
-    /// collocation points, then at the unbounded ones (2M rows): the pressure at the points
-    /// where the tangential solver samples the shear traction.
-    pub bounded_at_collocation: RowMatrix,
     /// The coarse companion grid ([`COARSE_NODES`] nodes, when M is at least three times
     /// that), on which the tangential solver builds the finite-difference Jacobian of a step.
     coarse: Option<Box<Discretisation>>,
@@ -56,22 +52,11 @@ impl Discretisation {
         let mut unit_psi = vec![0.0; m];
         bounded.solve(&rhs, &mut unit_psi);
         let unit_integral = bounded.integral(&unit_psi);
-        let points: Vec<f64> = bounded
-            .collocation
-            .iter()
-            .chain(&unbounded.collocation)
-            .copied()
-            .collect();
-        let mut bounded_at_collocation = RowMatrix::zeros(points.len(), m);
-        for (i, &tau) in points.iter().enumerate() {
-            BoundedSeries::density_row(tau, bounded_at_collocation.row_mut(i));
-        }
         Self {
             bounded,
             unbounded,
             unit_psi,
             unit_integral,
-            bounded_at_collocation,
             coarse: (m >= 3 * COARSE_NODES).then(|| Box::new(Discretisation::new(COARSE_NODES))),
         }
     }
@@ -79,6 +64,21 @@ impl Discretisation {
     /// Number of nodes M.
     pub fn nodes(&self) -> usize {
         self.bounded.len()
+    }
+
+    /// The density of a bounded series with coefficients `beta` at the bounded collocation
+    /// points, then at the unbounded ones, into `out` (2M values, or the first `out.len()`):
+    /// the pressure at the points where the tangential solver samples the shear traction
+    /// ([`BoundedGrid::densities_at_collocation`],
+    /// [`UnboundedGrid::bounded_densities_at_collocation`]).
+    pub fn bounded_at_collocation(&self, beta: &[f64], out: &mut [f64]) {
+        let m = self.nodes();
+        let (at_bounded, at_unbounded) = out.split_at_mut(m + 1);
+        self.bounded.densities_at_collocation(beta, at_bounded);
+        if !at_unbounded.is_empty() {
+            self.unbounded
+                .bounded_densities_at_collocation(beta, at_unbounded);
+        }
     }
 
     /// The coarse companion grid, when M is at least three times [`COARSE_NODES`]: on a finer

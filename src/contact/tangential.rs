@@ -33,9 +33,10 @@
 //! acceleration; the parts that depend only on the geometry (the remembered strain, the
 //! inherited correction and its Cauchy transform, the slip-shape function, and the matrices
 //! that map series coefficients to values at the other unknowns' points, `InnerMaps`) are
-//! built once per evaluation, so that a pass of the iteration is a handful of matrix–vector
-//! products (the collocation solves themselves are products with the precomputed
-//! transform-times-inverse matrices of [`crate::quadrature`]). The inner iteration starts from
+//! built once per evaluation, so that a pass of the iteration is three matrix–vector products
+//! and five fast cosine and sine transforms (the collocation solves and the pressure at the
+//! collocation points, which are Chebyshev transforms over the grids' points,
+//! [`crate::quadrature`]). The inner iteration starts from
 //! the previous iterate's coefficients and is solved only as far as the outer iteration needs:
 //! to 1e−3 of the residual being reduced (an inexact Newton method, `inner_tolerance`), and
 //! to 1e−14 for the residual that is accepted. When no attempt of a step
@@ -151,7 +152,7 @@ use std::sync::Arc;
 use serde::Serialize;
 
 use crate::error::SolveFailure;
-use crate::quadrature::{BoundedSeries, RowMatrix, UnboundedSeries, dot};
+use crate::quadrature::{BoundedSeries, ColumnMatrix, RowMatrix, UnboundedSeries, dot};
 
 use super::memory::Memory;
 use super::normal::arcsine_moment;
@@ -521,8 +522,7 @@ impl StepProblem<'_> {
         let mut own_inside = vec![0.0; maps.own_rows.len()];
         let mut x: Vec<f64> = if same_chain {
             let own = &guess_zone.expect("same chain").correction.beta;
-            disc.bounded_at_collocation
-                .apply(&guess.pressure.beta, &mut p_samples);
+            disc.bounded_at_collocation(&guess.pressure.beta, &mut p_samples);
             maps.own_at_samples_into(own, &mut own_inside, &mut own_samples);
             fixed_p
                 .iter()
@@ -639,8 +639,8 @@ impl StepProblem<'_> {
                 *r += f;
             }
             lambda_q = disc.bounded.solve_coefficients(&srhs, &mut beta_q);
-            // p and q̃'s own part at the sample points, each map's rows in one dispatch.
-            disc.bounded_at_collocation.apply(&beta_p, &mut p_samples);
+            // p at the sample points (sine transforms) and q̃'s own part there (its map).
+            disc.bounded_at_collocation(&beta_p, &mut p_samples);
             kinks.at_samples.add_apply(&amp, 1.0, &mut p_samples);
             maps.own_at_samples_into(&beta_q, &mut own_inside, &mut own_samples);
             for (k, (shape, inh)) in fixed_p.iter().chain(&fixed_c).enumerate() {
@@ -1010,22 +1010,22 @@ impl EndProbes {
 /// points, the stick right-hand side from the pressure (`local p − η s y11 H'p`, over y11) and
 /// from the charge (`w13 w`, over y11); at the pressure and charge points inside the stick
 /// zone, the density of the stick correction (zero at the others). (The pressure's density at
-/// its own and the charge's collocation points does not depend on the geometry:
-/// `Discretisation::bounded_at_collocation`.) For mixed slip signs,
+/// its own and the charge's collocation points does not depend on the geometry: it is a
+/// sine transform, [`Discretisation::bounded_at_collocation`].) For mixed slip signs,
 /// `H'(pS)(x) = S(x) H'p(x) + (1/π)∫ p(t)(S(t) − S(x))/(t − x) dt` at the stick points (as
 /// `ContactState::shape_cauchy`) is kept in three parts: `H'p` at the stick points, p at the
 /// graded nodes of the slip and stick pieces, and the quotient weights.
 #[derive(Default)]
 struct InnerMaps {
-    stick_from_p: RowMatrix,
-    stick_from_w: RowMatrix,
+    stick_from_p: ColumnMatrix,
+    stick_from_w: ColumnMatrix,
     /// Rows at the sample points inside the stick zone only (`own_rows`): q̃'s own part is
     /// zero outside.
-    own_at_samples: RowMatrix,
+    own_at_samples: ColumnMatrix,
     /// The indices of the sample points inside the stick zone, increasing.
     own_rows: Vec<usize>,
-    cauchy_at_stick: RowMatrix,
-    shape_nodes: RowMatrix,
+    cauchy_at_stick: ColumnMatrix,
+    shape_nodes: ColumnMatrix,
     shape_weights: RowMatrix,
     /// S at the stick points.
     stick_shape: Vec<f64>,
@@ -1067,26 +1067,26 @@ impl InnerMaps {
             // Cauchy row `−T_n`, n = 1..M): U and T obey the same three-term recurrence, so
             // their sum does, from `(η s, local √(1−τ²) + η s τ)` at n = 0 and 1. One sweep
             // over the M × M rows instead of three (two fills and a fold).
-            stick_from_p.refill_recurrence_rows(m, &taus, |t| {
+            stick_from_p.refill(m, &taus, |t| {
                 let [_, _, scale] = BoundedSeries::density_start(t);
                 [eta_s, k.local_over_y11 * scale + eta_s * t, 1.0]
             });
             // Mixed slip signs only keep the Cauchy rows apart.
-            cauchy_at_stick.reset(0, m);
+            cauchy_at_stick.clear();
         } else {
-            stick_from_p.refill_recurrence_rows(m, &taus, |t| {
+            stick_from_p.refill(m, &taus, |t| {
                 let [prev, first, scale] = BoundedSeries::density_start(t);
                 [prev, first, k.local_over_y11 * scale]
             });
-            cauchy_at_stick.refill_recurrence_rows(m, &taus, BoundedSeries::cauchy_start_inside);
+            cauchy_at_stick.refill(m, &taus, BoundedSeries::cauchy_start_inside);
         }
         if let Some(w13_over_y11) = k.charge {
-            stick_from_w.refill_recurrence_rows(m, &taus, |t| {
+            stick_from_w.refill(m, &taus, |t| {
                 let [prev, first, scale] = UnboundedSeries::density_start(t);
                 [prev, first, w13_over_y11 * scale]
             });
         } else {
-            stick_from_w.reset(0, m);
+            stick_from_w.clear();
         }
         let stick_shape: Vec<f64> = stick_points.iter().map(|&x| state.slip_shape(x)).collect();
         let (mid, half) = (stick.mid(), stick.half());
@@ -1101,13 +1101,13 @@ impl InnerMaps {
                 inside_taus.push(tau);
             }
         }
-        own_at_samples.refill_recurrence_rows(m, &inside_taus, BoundedSeries::density_start);
+        own_at_samples.refill(m, &inside_taus, BoundedSeries::density_start);
         let mut node_points = Vec::new();
         if k.shape.is_none() {
             let table = state.shape_quadrature(stick);
             node_points = table.iter().map(|&(t, _, _)| t).collect();
             let node_taus: Vec<f64> = table.iter().map(|&(t, _, _)| (t - c) / a).collect();
-            shape_nodes.refill_recurrence_rows(m, &node_taus, BoundedSeries::density_start);
+            shape_nodes.refill(m, &node_taus, BoundedSeries::density_start);
             shape_weights.reset(rows, table.len());
             for (i, (&xs, &sx)) in stick_points.iter().zip(&stick_shape).enumerate() {
                 for (wij, &(t, w, st)) in shape_weights.row_mut(i).iter_mut().zip(&table) {
@@ -1117,7 +1117,7 @@ impl InnerMaps {
                 }
             }
         } else {
-            shape_nodes.reset(0, 0);
+            shape_nodes.clear();
             shape_weights.reset(0, 0);
         }
         self.stick_shape = stick_shape;
