@@ -312,6 +312,10 @@ struct StepProblem<'a> {
     /// The last evaluation's [`InnerMaps`], whose matrices the next evaluation refills (one
     /// for all the attempts of a step).
     scratch: &'a RefCell<InnerMaps>,
+    /// The inherited link of the last evaluation, whose fade table the next evaluation reuses
+    /// when its ramps have hardly moved ([`Inherited::reusing_table_of`]; one for all the
+    /// attempts of a step, on both grids).
+    last_link: &'a RefCell<Option<Arc<Inherited>>>,
 }
 
 impl StepProblem<'_> {
@@ -333,8 +337,20 @@ impl StepProblem<'_> {
     ) -> Result<([f64; 4], ContactState, bool), SolveFailure> {
         let inherited = self
             .base
-            .and_then(|b| b.inheritance_for(g.lo, g.hi, self.disc.nodes()));
-        self.evaluate_with(g, guess, inherited, inner_tolerance)
+            .and_then(|b| b.inheritance_for(g.lo, g.hi, self.disc.nodes()))
+            .map(|link| {
+                let last = self.last_link.borrow();
+                match (Arc::try_unwrap(link), last.as_deref()) {
+                    (Ok(link), Some(built)) => Arc::new(link.reusing_table_of(built)),
+                    (Ok(link), None) => Arc::new(link),
+                    (Err(shared), _) => shared,
+                }
+            });
+        let evaluated = self.evaluate_with(g, guess, inherited.clone(), inner_tolerance);
+        if inherited.is_some() {
+            *self.last_link.borrow_mut() = inherited;
+        }
+        evaluated
     }
 
     /// As [`Self::evaluate`], with the inherited correction chosen by the caller (the
@@ -1511,6 +1527,7 @@ pub fn solve_slip(
     }
     let mut attempts = Attempts::default();
     let scratch = LentMaps::lend();
+    let last_link = RefCell::new(None);
     let problem_for = |signs: (f64, f64)| StepProblem {
         model,
         disc,
@@ -1520,6 +1537,7 @@ pub fn solve_slip(
         normal_load: start.normal_load,
         tangential_load,
         scratch: &scratch.0,
+        last_link: &last_link,
     };
     if let Some(step) = recalled.and_then(|r| recall(&problem_for, start, r, options)) {
         return Ok(step);
@@ -2488,6 +2506,7 @@ mod tests {
                     normal_load: sc.normal_load,
                     tangential_load: state.tangential_load,
                     scratch: &maps.0,
+                    last_link: &RefCell::new(None),
                 };
                 let (r, solved, _) = problem.evaluate(&g, state, INNER_TOLERANCE).unwrap();
                 assert!(norm(&r) < 1e-12, "M = {m}: residual {:e}", norm(&r));
