@@ -1200,6 +1200,9 @@ struct Anderson {
     /// reused for the newest once `depth` are held.
     d_res: VecDeque<Vec<f64>>,
     d_f: VecDeque<Vec<f64>>,
+    /// `gram[i][j] = d_res[i] · d_res[j]`, kept from pass to pass: a pass adds the newest
+    /// difference's row, not the whole matrix again.
+    gram: [[f64; SMALL]; SMALL],
     /// This pass's residual.
     res: Vec<f64>,
 }
@@ -1214,6 +1217,7 @@ impl Anderson {
             last_f: Vec::new(),
             d_res: VecDeque::with_capacity(depth + 1),
             d_f: VecDeque::with_capacity(depth + 1),
+            gram: [[0.0; SMALL]; SMALL],
             res: Vec::new(),
         }
     }
@@ -1224,6 +1228,12 @@ impl Anderson {
         self.res.extend(fx.iter().zip(x.iter()).map(|(f, v)| f - v));
         if self.started {
             let (mut dr, mut df) = if self.d_res.len() >= self.depth {
+                // The oldest difference leaves the Gram matrix too.
+                for i in 1..self.depth {
+                    for j in 1..self.depth {
+                        self.gram[i - 1][j - 1] = self.gram[i][j];
+                    }
+                }
                 (
                     self.d_res.pop_front().unwrap_or_default(),
                     self.d_f.pop_front().unwrap_or_default(),
@@ -1235,6 +1245,12 @@ impl Anderson {
             dr.extend(self.res.iter().zip(&self.last_res).map(|(a, b)| a - b));
             df.clear();
             df.extend(fx.iter().zip(&self.last_f).map(|(a, b)| a - b));
+            let newest = self.d_res.len();
+            for (i, di) in self.d_res.iter().enumerate() {
+                let g = dot(di, &dr);
+                (self.gram[i][newest], self.gram[newest][i]) = (g, g);
+            }
+            self.gram[newest][newest] = dot(&dr, &dr);
             self.d_res.push_back(dr);
             self.d_f.push_back(df);
         }
@@ -1247,13 +1263,12 @@ impl Anderson {
         if k == 0 {
             return;
         }
-        // Normal equations of min |res − ΔR γ| (k ≤ depth), lightly regularised.
-        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(u, v)| u * v).sum::<f64>();
+        // Normal equations of min |res − ΔR γ| (k ≤ depth), lightly regularised; the dot
+        // products in SIMD lanes (as scalar sums, a chain of dependent additions each, they
+        // took a third of a pass at M = 128).
         let mut gram = [[0.0; SMALL + 1]; SMALL];
-        for (row, di) in gram.iter_mut().zip(&self.d_res) {
-            for (g, dj) in row.iter_mut().zip(&self.d_res) {
-                *g = dot(di, dj);
-            }
+        for ((row, kept), di) in gram.iter_mut().zip(&self.gram).zip(&self.d_res) {
+            row[..k].copy_from_slice(&kept[..k]);
             row[k] = dot(di, &self.res);
         }
         let trace: f64 = (0..k).map(|i| gram[i][i]).sum::<f64>().max(1e-300);
