@@ -921,9 +921,11 @@ impl BoundedSeries {
     pub fn cauchys<const L: usize>(&self, tau: [f64; L]) -> [f64; L] {
         let (mut b1, mut b2) = ([0.0; L], [0.0; L]);
         if tau.iter().any(|t| t.abs() < 1.0) {
+            // `2τ b_{n+1} − (b_{n+2} + β_n)`: the sum in brackets does not wait for b_{n+1}.
+            let two_tau = tau.map(|t| 2.0 * t);
             for &bn in self.beta.iter().rev() {
                 for l in 0..L {
-                    let b0 = 2.0 * tau[l] * b1[l] - b2[l] - bn;
+                    let b0 = two_tau[l] * b1[l] - (b2[l] + bn);
                     b2[l] = b1[l];
                     b1[l] = b0;
                 }
