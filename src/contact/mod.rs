@@ -2319,6 +2319,32 @@ mod tests {
         }
     }
 
+    /// The tests' chain: a normal-loading-like zone (`alternating_series` of `terms` terms and a
+    /// centre kink) on [−0.95, 0.95], faded into the zone [−0.8, 0.4] with a series of its own
+    /// and the given extras, as in the first tangential phase; the base tabulated with
+    /// `base_nodes` points per piece when given.
+    fn faded_chain(
+        terms: usize,
+        base_nodes: Option<usize>,
+        extras: Vec<(f64, f64, f64)>,
+    ) -> StickZone {
+        let base = std::sync::Arc::new(StickZone::new(
+            -0.95,
+            0.95,
+            alternating_series(terms, 1.0),
+            -0.3,
+        ));
+        if let Some(nodes) = base_nodes {
+            base.tabulate(nodes);
+        }
+        let link = Inherited::new(base, Some((-0.8, -0.55)), Some((0.1, 0.4)));
+        StickZone {
+            inherited: Some(std::sync::Arc::new(link)),
+            extras,
+            ..StickZone::new(-0.8, 0.4, alternating_series(terms, 0.5), 0.0)
+        }
+    }
+
     /// The largest `|got − want|` over `points`, relative to the largest `|want|`.
     fn worst_relative(points: &[f64], got: impl Fn(f64) -> f64, want: impl Fn(f64) -> f64) -> f64 {
         let scale = points.iter().map(|&x| want(x).abs()).fold(0.0, f64::max);
@@ -2333,18 +2359,7 @@ mod tests {
         // A normal-loading-like zone (centre kink) faded into a narrower zone with a series of
         // its own, as in the first tangential phase; the table against the series and chain,
         // inside, next to every breakpoint, outside within the table and beyond it.
-        let base = std::sync::Arc::new(StickZone::new(
-            -0.95,
-            0.95,
-            alternating_series(64, 1.0),
-            -0.3,
-        ));
-        base.tabulate(96);
-        let link = Inherited::new(base, Some((-0.8, -0.55)), Some((0.1, 0.4)));
-        let zone = StickZone {
-            inherited: Some(std::sync::Arc::new(link)),
-            ..StickZone::new(-0.8, 0.4, alternating_series(64, 0.5), 0.0)
-        };
+        let zone = faded_chain(64, Some(96), Vec::new());
         let direct = zone.clone();
         zone.tabulate(96);
         let mut points: Vec<f64> = (0..=2000).map(|i| -2.1 + 3.7 * i as f64 / 2000.0).collect();
@@ -2376,19 +2391,7 @@ mod tests {
     /// the bit before and after.
     #[test]
     fn exterior_tables_match_the_direct_transform() {
-        let base = std::sync::Arc::new(StickZone::new(
-            -0.95,
-            0.95,
-            alternating_series(128, 1.0),
-            -0.3,
-        ));
-        base.tabulate(160);
-        let link = Inherited::new(base, Some((-0.8, -0.55)), Some((0.1, 0.4)));
-        let zone = StickZone {
-            inherited: Some(std::sync::Arc::new(link)),
-            extras: vec![(-0.55, 0.4, 0.2)],
-            ..StickZone::new(-0.8, 0.4, alternating_series(128, 0.5), 0.0)
-        };
+        let zone = faded_chain(128, Some(160), vec![(-0.55, 0.4, 0.2)]);
         let direct = zone.clone();
         let (w, mut out) = (zone.hi - zone.lo, Vec::new());
         let few: Vec<f64> = (1..=20)
@@ -2494,20 +2497,8 @@ mod tests {
         // chain untabulated: inside, next to every breakpoint, and outside (zero). Only the
         // zone with a link gets a value table.
         let chain = |tabulated: bool| {
-            let base = std::sync::Arc::new(StickZone::new(
-                -0.95,
-                0.95,
-                alternating_series(64, 1.0),
-                -0.3,
-            ));
-            let link = Inherited::new(base.clone(), Some((-0.8, -0.55)), Some((0.1, 0.4)));
-            let zone = StickZone {
-                inherited: Some(std::sync::Arc::new(link)),
-                extras: vec![(-0.55, 0.4, 0.2)],
-                ..StickZone::new(-0.8, 0.4, alternating_series(64, 0.5), 0.0)
-            };
+            let zone = faded_chain(64, tabulated.then_some(96), vec![(-0.55, 0.4, 0.2)]);
             if tabulated {
-                base.tabulate(96);
                 zone.tabulate(96);
             }
             zone
