@@ -263,7 +263,7 @@ pub struct StickZone {
     /// points of the slip zones (`EXTERIOR_TABLE_POINTS`; the checks and increments of the
     /// steps it ends and begins).
     #[serde(skip)]
-    exterior_table: ExteriorCache,
+    exterior_table: TableCache<[ChainTable; 2]>,
 }
 
 /// `H'q̃` of a zone with its whole chain, interpolated piecewise: on each piece between the
@@ -408,21 +408,16 @@ impl ChebyshevPoints {
 }
 
 /// A cache filled at most once that takes no part in comparisons.
-#[derive(Debug, Clone, Default)]
-struct TableCache(std::sync::OnceLock<ChainTable>);
+#[derive(Debug, Clone)]
+struct TableCache<T = ChainTable>(std::sync::OnceLock<T>);
 
-impl PartialEq for TableCache {
-    fn eq(&self, _: &Self) -> bool {
-        true
+impl<T> Default for TableCache<T> {
+    fn default() -> Self {
+        Self(std::sync::OnceLock::new())
     }
 }
 
-/// [`StickZone`]'s exterior tables (left, right), filled at most once; no part in
-/// comparisons.
-#[derive(Debug, Clone, Default)]
-struct ExteriorCache(std::sync::OnceLock<[ChainTable; 2]>);
-
-impl PartialEq for ExteriorCache {
+impl<T> PartialEq for TableCache<T> {
     fn eq(&self, _: &Self) -> bool {
         true
     }
@@ -961,7 +956,7 @@ impl StickZone {
             extras: Vec::new(),
             cauchy_table: TableCache::default(),
             value_table: TableCache::default(),
-            exterior_table: ExteriorCache::default(),
+            exterior_table: TableCache::default(),
         }
     }
 
