@@ -12,6 +12,10 @@ use fretsim::history::{
 };
 use fretsim::scenario::{Scenario, default_scenario};
 
+/// The command's allocator (`src/main.rs`), so that the benches time what a run does.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 const SIZES: [usize; 5] = [32, 64, 128, 256, 512];
 
 fn kernels(c: &mut Criterion) {

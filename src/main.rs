@@ -9,6 +9,14 @@ use fretsim::cli::{Cli, Command};
 use fretsim::error::Error;
 use fretsim::{app, material, scenario};
 
+/// mimalloc instead of the system allocator: a tangential step allocates and frees a few
+/// hundred small vectors (the per-evaluation point lists, maps and batches), and with glibc's
+/// allocator malloc and free took about 5 % of a step. Measured, the forward step at M = 128
+/// (interleaved timing loops, best of 400, five rounds): 1.50–1.52 → 1.42–1.44 ms, its state
+/// 1.15–1.16 → 1.08–1.10 ms. The library itself leaves the choice to the program.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match dispatch(cli.command) {
