@@ -13,6 +13,7 @@ use fretsim::history::{
 use fretsim::scenario::{Scenario, default_scenario};
 
 /// The command's allocator (`src/main.rs`), so that the benches time what a run does.
+#[cfg(feature = "mimalloc")]
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

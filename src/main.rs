@@ -15,7 +15,8 @@ use fretsim::{app, material, scenario};
 /// (interleaved timing loops, best of 400, five rounds): 1.50–1.52 → 1.42–1.44 ms, its state
 /// 1.15–1.16 → 1.08–1.10 ms. Built without transparent huge pages (the crate's `no_thp`
 /// feature): with them the default run's peak memory is 24–25 MB instead of about 10 MB. The
-/// library itself leaves the choice to the program.
+/// library itself sets no allocator; the dependency is the default feature `mimalloc`.
+#[cfg(feature = "mimalloc")]
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
