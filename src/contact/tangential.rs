@@ -2369,6 +2369,30 @@ pub fn assess_step(
 mod tests {
     use super::*;
 
+    /// The forward-slip problem (both slip zones positive) of the default scenario `sc` at the
+    /// driver's state, inheriting from `base`, with the given maps and caches.
+    fn forward_problem<'a>(
+        sc: &'a crate::scenario::Scenario,
+        disc: &'a Discretisation,
+        driver: &'a crate::history::DriverState,
+        base: Option<&'a Arc<StickZone>>,
+        maps: &'a RefCell<InnerMaps>,
+        (last_link, reused): (&'a RefCell<Option<Arc<Inherited>>>, &'a RefCell<Reused>),
+    ) -> StepProblem<'a> {
+        StepProblem {
+            model: &sc.model,
+            disc,
+            memory: &driver.memory,
+            base,
+            signs: (1.0, 1.0),
+            normal_load: sc.normal_load,
+            tangential_load: driver.state.tangential_load,
+            scratch: maps,
+            last_link,
+            reused,
+        }
+    }
+
     /// The end probes keep clear of a remembered stick end near a new one: a quarter and a half
     /// of its distance from the end when it lies within `4 END_PROBE h`, unless that is closer
     /// to the end than the series' first node; elsewhere `END_PROBE h` and twice that.
@@ -2640,18 +2664,14 @@ mod tests {
             .and_then(|z| z.inherited.clone());
         let maps = LentMaps::lend();
         let (last_link, shared) = (RefCell::new(None), RefCell::new(Reused::default()));
-        let with_shared = StepProblem {
-            model: &sc.model,
-            disc: &disc,
-            memory: &driver.memory,
-            base: base.as_ref(),
-            signs: (1.0, 1.0),
-            normal_load: sc.normal_load,
-            tangential_load: state.tangential_load,
-            scratch: &maps.0,
-            last_link: &last_link,
-            reused: &shared,
-        };
+        let with_shared = forward_problem(
+            &sc,
+            &disc,
+            &driver,
+            base.as_ref(),
+            &maps.0,
+            (&last_link, &shared),
+        );
         let evaluate = |p: &StepProblem<'_>, g: &Geometry| {
             let (r, s, _) = p
                 .evaluate_with(g, state, link.clone(), INNER_TOLERANCE)
@@ -2707,18 +2727,15 @@ mod tests {
             let at_state = |driver: &DriverState| {
                 let state = &driver.state;
                 let g = Geometry::of(state).expect("slip state");
-                let problem = StepProblem {
-                    model: &sc.model,
-                    disc: &disc,
-                    memory: &driver.memory,
-                    base: base.as_ref(),
-                    signs: (1.0, 1.0),
-                    normal_load: sc.normal_load,
-                    tangential_load: state.tangential_load,
-                    scratch: &maps.0,
-                    last_link: &RefCell::new(None),
-                    reused: &RefCell::new(Reused::default()),
-                };
+                let (last_link, reused) = (RefCell::new(None), RefCell::new(Reused::default()));
+                let problem = forward_problem(
+                    &sc,
+                    &disc,
+                    driver,
+                    base.as_ref(),
+                    &maps.0,
+                    (&last_link, &reused),
+                );
                 let (r, solved, _) = problem.evaluate(&g, state, INNER_TOLERANCE).unwrap();
                 assert!(norm(&r) < 1e-12, "M = {m}: residual {:e}", norm(&r));
                 let fine = fd_jacobian(&problem, &g, &r, &solved).unwrap();
