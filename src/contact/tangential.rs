@@ -328,11 +328,11 @@ struct StepProblem<'a> {
 /// unknown at a time, so two of its four evaluations find each part of its base point here
 /// and skip the chain's sums (measured on the bench's forward step at M = 128, interleaved
 /// timing loops, best of 400 in five rounds: 1.42–1.44 → 1.41–1.43 ms, its state 1.07–1.09
-/// → 1.07–1.08 ms; every output of the regression batch byte-identical, as it must be).
-/// An entry is taken only for the same grid,
-/// bit-identical points, the same inherited link (the same `Arc`) and extras and the same
-/// slip signs (and stick ends, for a mixed state's S), so what it holds is what the
-/// evaluation would compute, bit for bit.
+/// → 1.07–1.08 ms; every output of the regression batch byte-identical, as it must be). An
+/// entry is taken only for the same grid, bit-identical points, the same inherited link (the
+/// same `Arc`) and extras and the same slip signs (and stick ends, for a mixed state's S), so
+/// what it holds is what the evaluation would compute, bit for bit. It lives for one
+/// `solve_slip` call, whose attempts share one memory.
 #[derive(Default)]
 pub(super) struct Reused {
     stick: Vec<(PartsKey, Arc<StickParts>)>,
