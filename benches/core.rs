@@ -8,7 +8,8 @@ use fretsim::contact::normal::{NormalOptions, solve_normal};
 use fretsim::contact::pressure::Discretisation;
 use fretsim::contact::tangential::SlipOptions;
 use fretsim::history::{
-    DriverState, LoadHistory, LoadPoint, NoObserver, StepRecord, advance, run_history, solve_step,
+    DriverState, LoadHistory, LoadPoint, NoObserver, StepRecord, advance, continue_run,
+    run_history, solve_step,
 };
 use fretsim::scenario::{Scenario, default_scenario};
 
@@ -159,6 +160,71 @@ fn steps(c: &mut Criterion) {
     );
 }
 
+/// Time per step of four forward steps (0.30 → 0.35 → … → 0.50 ηP, from a clone of the driver
+/// after 0.1, 0.2 and 0.3 ηP) as a run takes them ([`continue_run`]: each step's increments
+/// on a second thread while the next step is solved), and the same four steps one after the
+/// other on one thread ([`advance`]).
+fn steps_in_a_run(c: &mut Criterion) {
+    let sc = default_scenario();
+    let loads = [0.1, 0.2, 0.3];
+    let next = [0.35, 0.40, 0.45, 0.50];
+    let points: Vec<LoadPoint> = next
+        .iter()
+        .enumerate()
+        .map(|(k, f)| LoadPoint {
+            step: loads.len() + k + 1,
+            t: (loads.len() + k + 1) as f64,
+            q: f * sc.model.friction * sc.normal_load,
+        })
+        .collect();
+    for (name, pipelined) in [
+        ("run/forward_step_in_a_run", true),
+        ("run/forward_step_sequential", false),
+    ] {
+        let mut g = c.benchmark_group(name);
+        g.sample_size(10);
+        for m in SIZES {
+            let disc = Discretisation::new(m);
+            let driver = driver_after(&sc, &disc, &loads);
+            g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
+                b.iter_custom(|iters| {
+                    per_step(iters, next.len(), || {
+                        let mut d = driver.clone();
+                        if pipelined {
+                            let mut records = Vec::new();
+                            let failure = continue_run(
+                                &sc.model,
+                                &disc,
+                                &mut d,
+                                &points,
+                                SlipOptions::default(),
+                                &mut NoObserver,
+                                &mut records,
+                            );
+                            assert!(failure.is_none());
+                            black_box(records);
+                        } else {
+                            for (k, f) in next.iter().enumerate() {
+                                black_box(step(&sc, &disc, &mut d, loads.len() + k + 1, *f));
+                            }
+                        }
+                    })
+                })
+            });
+        }
+        g.finish();
+    }
+}
+
+/// The time of `iters` calls of `steps`, per step (`count` steps a call).
+fn per_step(iters: u64, count: usize, mut steps: impl FnMut()) -> std::time::Duration {
+    let start = std::time::Instant::now();
+    for _ in 0..iters {
+        steps();
+    }
+    start.elapsed() / count as u32
+}
+
 fn recalled(c: &mut Criterion) {
     // The same step, 0.30 → 0.35 ηP, in the third forward phase of the default history: that
     // phase began from the same turning state (−½ ηP) as the second, whose step at 0.35 ηP
@@ -271,6 +337,7 @@ criterion_group!(
     kernels,
     normal,
     steps,
+    steps_in_a_run,
     recalled,
     reversal,
     cycle,

@@ -21,7 +21,8 @@
 //! of the electric load ([`StepIncrements`], [`step_dissipation`]) — need only the step's two
 //! states, and the next step needs none of them, so [`run_history`] computes them on a second
 //! thread while it solves the next step ([`solve_step`], then [`finish_step`] in order);
-//! [`advance`] does the same sequentially. The records are the same either way.
+//! [`continue_run`] does the same from any driver state, and [`advance`] does it
+//! sequentially. The records are the same either way.
 //!
 //! # Warm start
 //! Inside a phase the geometry of the step (stick ends, contact half-width and centre) is
@@ -1121,13 +1122,50 @@ pub fn run_history(
         }
     }
     steps.extend(history.steps().into_iter().map(|(_, t, q)| (t, q)));
-    // Pipelined on two threads: a step's increments (δ, dissipation, δn: a third of the work
-    // of a step) need only its two states, so they are computed on a worker thread while the
-    // next step is solved; steps are finished in order, so records, δ and the observer's calls
-    // are those of the sequential `advance`. One worker for the run (a thread spawned per
-    // step cost its stack mappings and wake-ups at every step). A step whose increments are
-    // known (a recalled step, `SolvedStep::known_increments`) sends the worker nothing.
-    let failure = std::thread::scope(|scope| {
+    let points: Vec<LoadPoint> = steps
+        .into_iter()
+        .enumerate()
+        .map(|(i, (t, q))| LoadPoint { step: i + 1, t, q })
+        .collect();
+    let failure = continue_run(
+        model,
+        disc,
+        &mut driver,
+        &points,
+        options,
+        observer,
+        &mut records,
+    );
+    match failure {
+        None => Ok(HistoryRun { records, driver }),
+        Some(failure) => Err(Box::new(HistoryFailure {
+            records,
+            driver,
+            failure,
+        })),
+    }
+}
+
+/// Walk the load points `points` from `driver` as [`run_history`] does, pushing a record per
+/// step onto `records` (the observer sees each), and return the first failure, if any (the
+/// driver is then at the last accepted step).
+///
+/// Pipelined on two threads: a step's increments (δ, dissipation, δn: a third of the work of
+/// a step) need only its two states, so they are computed on a worker thread while the next
+/// step is solved; steps are finished in order, so records, δ and the observer's calls are
+/// those of the sequential [`advance`]. One worker for the run (a thread spawned per step
+/// cost its stack mappings and wake-ups at every step). A step whose increments are known (a
+/// recalled step, [`SolvedStep::known_increments`]) sends the worker nothing.
+pub fn continue_run(
+    model: &ContactModel,
+    disc: &Discretisation,
+    driver: &mut DriverState,
+    points: &[LoadPoint],
+    options: SlipOptions,
+    observer: &mut dyn Observer,
+    records: &mut Vec<StepRecord>,
+) -> Option<StepFailure> {
+    std::thread::scope(|scope| {
         let (jobs, inbox) = std::sync::mpsc::channel::<IncrementInputs>();
         let (outbox, results) = std::sync::mpsc::channel();
         scope.spawn(move || {
@@ -1154,17 +1192,16 @@ pub fn run_history(
             }
         };
         let mut pending: Option<Box<SolvedStep>> = None;
-        for (i, (t, q)) in steps.into_iter().enumerate() {
-            let point = LoadPoint { step: i + 1, t, q };
-            let solved = solve_step(model, disc, &mut driver, point, options);
-            finish(pending.take(), &mut driver, &mut records, observer);
+        for &point in points {
+            let solved = solve_step(model, disc, driver, point, options);
+            finish(pending.take(), driver, records, observer);
             match solved {
                 Ok(Solved::Hold(regime)) => {
-                    records.push(hold_record(&driver, point, regime, observer));
+                    records.push(hold_record(driver, point, regime, observer));
                 }
                 Ok(Solved::Slip(solved)) => {
                     if solved.known_increments().is_none() {
-                        jobs.send(solved.increment_inputs(&driver))
+                        jobs.send(solved.increment_inputs(driver))
                             .expect("the increments worker runs until the steps end");
                     }
                     pending = Some(solved);
@@ -1172,17 +1209,9 @@ pub fn run_history(
                 Err(failure) => return Some(failure),
             }
         }
-        finish(pending.take(), &mut driver, &mut records, observer);
+        finish(pending.take(), driver, records, observer);
         None
-    });
-    match failure {
-        None => Ok(HistoryRun { records, driver }),
-        Some(failure) => Err(Box::new(HistoryFailure {
-            records,
-            driver,
-            failure,
-        })),
-    }
+    })
 }
 
 #[cfg(test)]

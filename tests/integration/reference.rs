@@ -1396,11 +1396,14 @@ fn contact_quadrature_resolves_the_stick_zone_kink() {
 
 /// `run_history` computes each step's increments on a second thread while it solves the next
 /// step: its records (δ, dissipation, works, in order) must be those of stepping the driver
-/// with the sequential `advance`, through a reversal and a hold.
+/// with the sequential `advance`, through a reversal and a hold; and so must those of
+/// `continue_run` from a driver stepped part of the way.
 #[test]
 fn pipelined_history_matches_sequential_steps() {
     use fretsim::contact::tangential::SlipOptions;
-    use fretsim::history::{DriverState, LoadHistory, LoadPoint, NoObserver, advance, run_history};
+    use fretsim::history::{
+        DriverState, LoadHistory, LoadPoint, NoObserver, advance, continue_run, run_history,
+    };
     let b = baseline(32);
     let history = LoadHistory {
         points: vec![
@@ -1422,24 +1425,17 @@ fn pipelined_history_matches_sequential_steps() {
         &mut NoObserver,
     )
     .unwrap();
-    let mut driver = DriverState::after_normal_loading(&b.normal);
-    let sequential: Vec<_> = history
+    let points: Vec<LoadPoint> = history
         .steps()
         .into_iter()
         .enumerate()
-        .map(|(i, (_, t, q))| {
-            let point = LoadPoint { step: i + 1, t, q };
-            advance(
-                &b.model,
-                &b.disc,
-                &mut driver,
-                point,
-                options,
-                &mut NoObserver,
-            )
-            .unwrap()
-        })
+        .map(|(i, (_, t, q))| LoadPoint { step: i + 1, t, q })
         .collect();
+    let step = |driver: &mut DriverState, point: &LoadPoint| {
+        advance(&b.model, &b.disc, driver, *point, options, &mut NoObserver).unwrap()
+    };
+    let mut driver = DriverState::after_normal_loading(&b.normal);
+    let sequential: Vec<_> = points.iter().map(|p| step(&mut driver, p)).collect();
     assert_eq!(run.records.len(), sequential.len() + 1);
     assert!(sequential.iter().any(|r| r.dissipation > 0.0));
     assert_eq!(&run.records[1..], &sequential[..]);
@@ -1447,6 +1443,24 @@ fn pipelined_history_matches_sequential_steps() {
         run.driver.displacement.to_bits(),
         driver.displacement.to_bits()
     );
+    // Two steps sequentially, then the rest (the hold, the reversal) as a run continues.
+    let mut part = DriverState::after_normal_loading(&b.normal);
+    for p in &points[..2] {
+        step(&mut part, p);
+    }
+    let mut records = Vec::new();
+    let failure = continue_run(
+        &b.model,
+        &b.disc,
+        &mut part,
+        &points[2..],
+        options,
+        &mut NoObserver,
+        &mut records,
+    );
+    assert!(failure.is_none());
+    assert_eq!(&records[..], &sequential[2..]);
+    assert_eq!(part.displacement.to_bits(), driver.displacement.to_bits());
 }
 
 /// A phase that begins from the same turning state as an earlier phase of its direction
