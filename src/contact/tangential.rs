@@ -2382,6 +2382,25 @@ fn slip_work_densities(
 mod tests {
     use super::*;
 
+    /// One load step of scenario `sc` by the driver (`advance`, default options).
+    fn advance_driver(
+        sc: &crate::scenario::Scenario,
+        disc: &Discretisation,
+        driver: &mut crate::history::DriverState,
+        point: crate::history::LoadPoint,
+    ) {
+        let mut observer = crate::history::NoObserver;
+        crate::history::advance(
+            &sc.model,
+            disc,
+            driver,
+            point,
+            SlipOptions::default(),
+            &mut observer,
+        )
+        .unwrap();
+    }
+
     /// The forward-slip problem (both slip zones positive) of the default scenario `sc` at the
     /// driver's state, inheriting from `base`, with the given maps and caches.
     fn forward_problem<'a>(
@@ -2644,7 +2663,7 @@ mod tests {
     #[test]
     fn reused_parts_leave_the_evaluations_unchanged() {
         use crate::contact::normal::{NormalOptions, solve_normal};
-        use crate::history::{DriverState, LoadPoint, NoObserver, advance};
+        use crate::history::{DriverState, LoadPoint};
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(64);
         let normal =
@@ -2657,15 +2676,7 @@ mod tests {
                 t: (step + 1) as f64,
                 q,
             };
-            advance(
-                &sc.model,
-                &disc,
-                &mut driver,
-                point,
-                SlipOptions::default(),
-                &mut NoObserver,
-            )
-            .unwrap();
+            advance_driver(&sc, &disc, &mut driver, point);
         }
         let base = normal.state.traction.stick.clone().map(Arc::new);
         let state = &driver.state;
@@ -2726,7 +2737,7 @@ mod tests {
     #[test]
     fn coarse_jacobian_is_near_the_fine_one() {
         use crate::contact::normal::{NormalOptions, solve_normal};
-        use crate::history::{DriverState, LoadPoint, NoObserver, advance};
+        use crate::history::{DriverState, LoadPoint};
         let sc = crate::scenario::default_scenario();
         let limit = sc.model.friction * sc.normal_load;
         for m in [80, 96, 128] {
@@ -2774,16 +2785,7 @@ mod tests {
                     t: step as f64,
                     q: 0.05 * step as f64 * limit,
                 };
-                let options = SlipOptions::default();
-                advance(
-                    &sc.model,
-                    &disc,
-                    &mut driver,
-                    point,
-                    options,
-                    &mut NoObserver,
-                )
-                .unwrap();
+                advance_driver(&sc, &disc, &mut driver, point);
                 if step >= 5 {
                     let (fine, coarse) = at_state(&driver);
                     if let Some(carried) = previous {
@@ -2804,7 +2806,7 @@ mod tests {
     /// zone, relative to the step's largest), with the states the driver reaches.
     #[test]
     fn the_slip_check_rule_reads_the_sign_to_a_small_error() {
-        use crate::history::{DriverState, LoadPoint, NoObserver, advance};
+        use crate::history::{DriverState, LoadPoint};
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(sc.collocation_points);
         let normal = crate::contact::normal::solve_normal(
@@ -2821,16 +2823,7 @@ mod tests {
         for (i, &(_, t, q)) in steps.iter().take(30).enumerate() {
             let old = driver.state.clone();
             let point = LoadPoint { step: i + 1, t, q };
-            let options = SlipOptions::default();
-            advance(
-                &sc.model,
-                &disc,
-                &mut driver,
-                point,
-                options,
-                &mut NoObserver,
-            )
-            .unwrap();
+            advance_driver(&sc, &disc, &mut driver, point);
             let new = &driver.state;
             if new.traction.stick.is_none() || old.traction.stick.is_none() {
                 continue;
