@@ -1875,7 +1875,7 @@ pub fn slip_zone_rule_nodes(m: usize) -> usize {
 /// The check only needs the sign, to 1e−2 of the largest slip of the step. Measured over the
 /// 22 scenarios of the regression batch (M = 64 … 256, coupled and uncoupled, many cycles and
 /// variable amplitude) against eight times the nodes: the worst check measure within 1.2e−4,
-/// every state unchanged; half of [`slip_zone_rule_nodes`] gave 1.3e−7 at 7 % more of a
+/// every state unchanged; half of [`slip_zone_rule_nodes`] gave 1.3e−7 at 8 % more of a
 /// forward step's solve at M = 128 (test `the_slip_check_rule_reads_the_sign_to_a_small_error`).
 pub fn slip_check_rule_nodes(m: usize) -> usize {
     slip_zone_rule_nodes(m) / 4

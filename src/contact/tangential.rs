@@ -674,9 +674,9 @@ impl StepProblem<'_> {
         // changed them ten times more than the traction. Measured with the stored roots: inner
         // passes −7 to −11 % over the default histories at M = 64 and 128, the insulating
         // Figure-3 history at M = 128 and the PZT-4 variable-amplitude one; the forward step's
-        // state at M = 128 3.5 % faster; the regression batch 8661 → 8707 evaluations, every
-        // geometry within 2.4e−11 a but the stalled step 47 of the insulating Figure-3 history
-        // at η = 0.4, 7.7e−7 a away.)
+        // state at M = 128 4 % faster (at M = 256 one evaluation more, by round-off); the
+        // regression batch 8661 → 8707 evaluations, every geometry within 2.4e−11 a but the
+        // stalled step 47 of the insulating Figure-3 history at η = 0.4, 7.7e−7 a away.)
         if coupled {
             x.extend(guess_zone.map_or([0.0; 2], |z| {
                 if same_chain {
