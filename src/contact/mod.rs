@@ -1852,15 +1852,48 @@ pub struct GradedTable {
     pub total: f64,
 }
 
-/// Nodes per piece of the graded rule of the contact integrals (δ, δn, the arcsine moment, the
-/// shape force of mixed states): `max(32, M/2)`, since a piece holds a share of the M-term
-/// series and the stick zone, one long piece, holds q̃'s whole series. Measured on the default
-/// history, M = 64 … 512, against four times the nodes: δ within 9e−11 of its range. A fixed
-/// 32-node rule let δ err by 3e−7 of its range at M = 128 and 1e−5 at M = 256, as much as
-/// the discretisation error of δ there.
+/// The most nodes a piece of the contact integrals' rule takes (δ, δn, the arcsine moment, the
+/// shape force of mixed states; [`contact_piece_nodes`] gives short pieces fewer):
+/// `max(32, M/2)`, since a piece holds a share of the M-term series and the stick zone, one
+/// long piece, holds q̃'s whole series. Measured on the default history, M = 64 … 512, against
+/// four times the nodes: δ within 9e−11 of its range (over the 22-run regression batch 1.5e−6,
+/// in the insulating Figure-3 histories at M = 64). A fixed 32-node rule let δ err by 3e−7 of
+/// its range at M = 128 and 1e−5 at M = 256, as much as the discretisation error of δ there.
 pub fn field_rule_nodes(m: usize) -> usize {
     32.max(m / 2)
 }
+
+/// Nodes of the contact integrals' rule on the piece `[x0, x1]` of the contact `(c, a)`: in
+/// proportion to the piece's share s of the contact in θ (`x = c + a cos θ`, the variable in
+/// which the M-term series oscillate evenly), `8 s field_rule_nodes(M)` rounded up to a
+/// multiple of 8, at least `CONTACT_PIECE_MIN_NODES` and at most `field_rule_nodes(M)`. The
+/// long pieces and those at the contact ends keep the whole rule; the short pieces between
+/// the chain's points get fewer. Measured over the 22-run regression batch against four
+/// times [`field_rule_nodes`] on every piece (itself within 8.4e−12 of δ's range of eight
+/// times): δ within 1.5e−8 of its range at M ≥ 96 (the whole rule: 4.3e−11), the geometry
+/// (through φ0's arcsine moment) within 2.4e−11 a and the dissipation within 4e−9 of the
+/// largest step dissipation, as with the whole rule (the stalled step 47 of the insulating
+/// Figure-3 history at η = 0.4 aside, which moves with any change of round-off). The forward
+/// step of the bench at M = 128 with its increments: 1.34–1.36 → 1.27–1.28 ms (best of 400,
+/// five interleaved rounds; its state alone within 1 %).
+fn contact_piece_nodes(x0: f64, x1: f64, (c, a): (f64, f64), m: usize) -> usize {
+    let most = field_rule_nodes(m);
+    let theta = |x: f64| ((x - c) / a).clamp(-1.0, 1.0).acos();
+    let share = (theta(x0) - theta(x1)).abs() / std::f64::consts::PI;
+    ((8.0 * share * most as f64).ceil() as usize)
+        .next_multiple_of(8)
+        .clamp(CONTACT_PIECE_MIN_NODES.min(most), most)
+}
+
+/// The fewest nodes of a piece of the contact integrals' rule ([`contact_piece_nodes`]): a
+/// short piece still carries square-root and logarithmic behaviour at its ends, so the rule
+/// changes nothing at M ≤ 64. Measured over the regression batch against four times the whole
+/// rule: with 16, δ erred by up to 2.2e−5 of its range (the insulating Figure-3 history at
+/// M = 64) whatever the proportion (4, 8 or 16 × the share); with 24, by up to 6.1e−8 in
+/// runs where the whole rule errs by 4.3e−11 or less; with 32, by up to 1.5e−8 (at M = 256;
+/// 9.6e−9 at M = 128). δ's discretisation error is 1.5e−6 of its range at M = 128 (the
+/// default history against M = 256).
+const CONTACT_PIECE_MIN_NODES: usize = 32;
 
 /// Nodes per piece of the graded rule over the slip zones (the dissipation):
 /// `max(32, M/4)`; the slip zones are split into shorter pieces than the contact. Measured on
@@ -1881,22 +1914,16 @@ pub fn slip_check_rule_nodes(m: usize) -> usize {
     slip_zone_rule_nodes(m) / 4
 }
 
-/// `∫ f` from the smallest to the largest of `points`, split at every point with the pieces
-/// balanced (none more than three times as long as a neighbour, `piece_ends`), each piece by a
-/// `nodes`-point sine-graded Gauss–Legendre rule (nodes clustered like Chebyshev points at
-/// both ends, which absorbs square-root and logarithmic behaviour there: every point where f
-/// is not smooth must be among `points`). f is evaluated at all the pieces' nodes in one
-/// call: `f(xs, out)` pushes the values at `xs` onto `out` (passed empty).
-pub fn graded_integral(points: Vec<f64>, nodes: usize, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> f64 {
-    graded_rule_with(nodes).integral(points, f)
-}
-
-/// The nodes and weights of [`graded_integral`]'s rule over the balanced pieces between
-/// `points`, in increasing x: `∫ f ≈ Σ weight f(node)`.
-pub fn graded_nodes(points: Vec<f64>, nodes: usize) -> (Vec<f64>, Vec<f64>) {
-    let rule = graded_rule_with(nodes);
+/// The nodes and weights of a graded rule over the balanced pieces between `points` (none more
+/// than three times as long as a neighbour, `piece_ends`), in increasing x, so that
+/// `∫ f ≈ Σ weight f(node)` from the smallest to the largest of `points`: each piece `[x0, x1]`
+/// by a `nodes(x0, x1)`-point sine-graded Gauss–Legendre rule (nodes clustered like Chebyshev
+/// points at both ends, which absorbs square-root and logarithmic behaviour there: every point
+/// where f is not smooth must be among `points`).
+pub fn graded_nodes(points: Vec<f64>, nodes: impl Fn(f64, f64) -> usize) -> (Vec<f64>, Vec<f64>) {
     let (mut at, mut weights) = (Vec::new(), Vec::new());
     for w in piece_ends(points).windows(2) {
+        let rule = graded_rule_with(nodes(w[0], w[1]));
         let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
         at.extend(rule.nodes.iter().map(|u| mid + half * u));
         weights.extend(rule.weights.iter().map(|wt| half * wt));
@@ -1905,11 +1932,12 @@ pub fn graded_nodes(points: Vec<f64>, nodes: usize) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// Tabulate f on the `nodes`-point graded rule over the balanced pieces between `points` (as
-/// [`graded_integral`]) together with the running integral up to each node, from the
+/// [`graded_nodes`]) together with the running integral up to each node, from the
 /// cumulative Gauss–Legendre matrix in the graded variable
 /// ([`crate::quadrature::gauss_legendre_cumulative`]). Nested integrals such as
-/// `∫ g(t) ∫_t^R f ds dt` then cost one evaluation of f per node (f as in
-/// [`graded_integral`]).
+/// `∫ g(t) ∫_t^R f ds dt` then cost one evaluation of f per node: f is evaluated at all the
+/// pieces' nodes in one call, `f(xs, out)` pushing the values at `xs` onto `out` (passed
+/// empty).
 pub fn graded_cumulative(
     points: Vec<f64>,
     nodes: usize,
@@ -2021,25 +2049,9 @@ impl GradedRule {
         (pieces, at)
     }
 
-    /// `∫ f` over the balanced pieces between `points` (see [`piece_ends`]). f is evaluated
-    /// at all the pieces' nodes in one call (its per-call work, such as an inherited zone's
-    /// grouping of the points, is then done once).
-    fn integral(&self, points: Vec<f64>, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> f64 {
-        let (pieces, at) = self.piece_nodes(points);
-        let mut values = Vec::with_capacity(at.len());
-        f(&at, &mut values);
-        pieces
-            .iter()
-            .zip(values.chunks_exact(self.nodes.len()))
-            .map(|(&(_, half), values)| {
-                let sum: f64 = self.weights.iter().zip(values).map(|(wt, v)| wt * v).sum();
-                half * sum
-            })
-            .sum()
-    }
-
     /// The running integral of f over the balanced pieces between `points` at every node,
-    /// f evaluated at all the nodes in one call (as [`Self::integral`]).
+    /// f evaluated at all the nodes in one call (its per-call work, such as an inherited
+    /// zone's grouping of the points, is then done once).
     fn cumulative(
         &self,
         points: Vec<f64>,
@@ -2191,17 +2203,24 @@ impl ContactModel {
 }
 
 impl ContactState {
-    /// `∫ f dt` over the contact by [`graded_integral`], split at the traction's breakpoints
+    /// `∫ f dt` over the contact by the contact integrals' rule ([`contact_piece_nodes`] on
+    /// the pieces of [`graded_nodes`]), split at the traction's breakpoints
     /// and at `split` (if inside). With the centre kink of a normal-loading zone among the
     /// breakpoints (it was missing before), the arcsine moment's φ0 over the default history
     /// agrees with a 256-node rule to 1e−10 V of 17 V (the 96-node rule without the kink point:
     /// 8e−7 V).
     pub fn contact_integral(&self, split: Option<f64>, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> f64 {
-        graded_integral(
-            self.contact_points(split),
-            field_rule_nodes(self.pressure.beta.len()),
-            f,
-        )
+        let (at, weights) = self.contact_nodes(self.contact_points(split));
+        let mut values = Vec::with_capacity(at.len());
+        f(&at, &mut values);
+        weights.iter().zip(&values).map(|(w, v)| w * v).sum()
+    }
+
+    /// The nodes and weights of the contact integrals' rule over the balanced pieces between
+    /// `points` ([`graded_nodes`] with [`contact_piece_nodes`]).
+    fn contact_nodes(&self, points: Vec<f64>) -> (Vec<f64>, Vec<f64>) {
+        let (contact, m) = ((self.centre, self.half_width), self.pressure.beta.len());
+        graded_nodes(points, |x0, x1| contact_piece_nodes(x0, x1, contact, m))
     }
 
     /// The contact ends, the traction's breakpoints inside the contact and `split` (if inside).
@@ -2239,10 +2258,24 @@ impl ContactState {
     /// the records' δ against four times the nodes: 8.5e−12 of its range (default history,
     /// M = 32; 8.5e−11 before) and 5.2e−10 (Figure-3 history with Γ = 4e−7 C/m; 1.5e−9).
     pub fn displacement_and_approach(&self, model: &ContactModel, x: f64) -> (f64, f64) {
+        let (contact, m) = ((self.centre, self.half_width), self.pressure.beta.len());
+        self.displacement_and_approach_with(model, x, |x0, x1| {
+            contact_piece_nodes(x0, x1, contact, m)
+        })
+    }
+
+    /// [`Self::displacement_and_approach`] with `nodes(x0, x1)` nodes on the piece `[x0, x1]`
+    /// instead of the contact integrals' rule.
+    pub(crate) fn displacement_and_approach_with(
+        &self,
+        model: &ContactModel,
+        x: f64,
+        nodes: impl Fn(f64, f64) -> usize,
+    ) -> (f64, f64) {
         let centre = self.centre;
         let mut points = self.contact_points(Some(x));
         points.push(centre);
-        let (at, weights) = graded_nodes(points, field_rule_nodes(self.pressure.beta.len()));
+        let (at, weights) = graded_nodes(points, nodes);
         // p, w and q at the nodes, then at x and the centre.
         let fields = |xs: &[f64]| {
             let (mut p, mut w, mut q) = (Vec::new(), Vec::new(), Vec::new());
