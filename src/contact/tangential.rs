@@ -2420,6 +2420,21 @@ mod tests {
         .unwrap();
     }
 
+    /// The driver of scenario `sc` at the end of its normal loading on `disc`.
+    fn driver_after_normal_loading(
+        sc: &crate::scenario::Scenario,
+        disc: &Discretisation,
+    ) -> crate::history::DriverState {
+        let normal = crate::contact::normal::solve_normal(
+            &sc.model,
+            disc,
+            sc.normal_load,
+            crate::contact::normal::NormalOptions::default(),
+        )
+        .unwrap();
+        crate::history::DriverState::after_normal_loading(&normal)
+    }
+
     /// The forward-slip problem (both slip zones positive) of the default scenario `sc` at the
     /// driver's state, inheriting from `base`, with the given maps and caches.
     fn forward_problem<'a>(
@@ -2825,17 +2840,10 @@ mod tests {
     /// zone, relative to the step's largest), with the states the driver reaches.
     #[test]
     fn the_slip_check_rule_reads_the_sign_to_a_small_error() {
-        use crate::history::{DriverState, LoadPoint};
+        use crate::history::LoadPoint;
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(sc.collocation_points);
-        let normal = crate::contact::normal::solve_normal(
-            &sc.model,
-            &disc,
-            sc.normal_load,
-            crate::contact::normal::NormalOptions::default(),
-        )
-        .unwrap();
-        let mut driver = DriverState::after_normal_loading(&normal);
+        let mut driver = driver_after_normal_loading(&sc, &disc);
         let steps = sc.history.as_ref().expect("default history").steps();
         let nodes = crate::contact::slip_check_rule_nodes(disc.nodes());
         let mut worst: f64 = 0.0;
@@ -2865,17 +2873,10 @@ mod tests {
     /// history at M = 128 (at M ≤ 64 the rule is the whole rule).
     #[test]
     fn the_contact_rule_gives_the_displacements_to_a_small_error() {
-        use crate::history::{DriverState, LoadPoint};
+        use crate::history::LoadPoint;
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(128);
-        let normal = crate::contact::normal::solve_normal(
-            &sc.model,
-            &disc,
-            sc.normal_load,
-            crate::contact::normal::NormalOptions::default(),
-        )
-        .unwrap();
-        let mut driver = DriverState::after_normal_loading(&normal);
+        let mut driver = driver_after_normal_loading(&sc, &disc);
         let steps = sc.history.as_ref().expect("default history").steps();
         let fine = 4 * crate::contact::field_rule_nodes(disc.nodes());
         let (mut rule, mut reference) = (Vec::new(), Vec::new());
