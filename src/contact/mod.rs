@@ -2210,17 +2210,17 @@ impl ContactState {
     /// agrees with a 256-node rule to 1e−10 V of 17 V (the 96-node rule without the kink point:
     /// 8e−7 V).
     pub fn contact_integral(&self, split: Option<f64>, f: &dyn Fn(&[f64], &mut Vec<f64>)) -> f64 {
-        let (at, weights) = self.contact_nodes(self.contact_points(split));
+        let (at, weights) = graded_nodes(self.contact_points(split), self.contact_rule());
         let mut values = Vec::with_capacity(at.len());
         f(&at, &mut values);
         weights.iter().zip(&values).map(|(w, v)| w * v).sum()
     }
 
-    /// The nodes and weights of the contact integrals' rule over the balanced pieces between
-    /// `points` ([`graded_nodes`] with [`contact_piece_nodes`]).
-    fn contact_nodes(&self, points: Vec<f64>) -> (Vec<f64>, Vec<f64>) {
+    /// The nodes of the contact integrals' rule on a piece `[x0, x1]` of this contact
+    /// ([`contact_piece_nodes`]), for [`graded_nodes`].
+    fn contact_rule(&self) -> impl Fn(f64, f64) -> usize + use<> {
         let (contact, m) = ((self.centre, self.half_width), self.pressure.beta.len());
-        graded_nodes(points, |x0, x1| contact_piece_nodes(x0, x1, contact, m))
+        move |x0, x1| contact_piece_nodes(x0, x1, contact, m)
     }
 
     /// The contact ends, the traction's breakpoints inside the contact and `split` (if inside).
@@ -2258,10 +2258,7 @@ impl ContactState {
     /// the records' δ against four times the nodes: 8.5e−12 of its range (default history,
     /// M = 32; 8.5e−11 before) and 5.2e−10 (Figure-3 history with Γ = 4e−7 C/m; 1.5e−9).
     pub fn displacement_and_approach(&self, model: &ContactModel, x: f64) -> (f64, f64) {
-        let (contact, m) = ((self.centre, self.half_width), self.pressure.beta.len());
-        self.displacement_and_approach_with(model, x, |x0, x1| {
-            contact_piece_nodes(x0, x1, contact, m)
-        })
+        self.displacement_and_approach_with(model, x, self.contact_rule())
     }
 
     /// [`Self::displacement_and_approach`] with `nodes(x0, x1)` nodes on the piece `[x0, x1]`
