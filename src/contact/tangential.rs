@@ -2402,7 +2402,7 @@ fn slip_work_densities(
             .collect();
         pts.extend(&samples);
         pts.extend([left, right]);
-        let table = super::graded_cumulative(pts, nodes, &mut d_strain);
+        let table = super::graded_cumulative(pts, nodes, None, &mut d_strain);
         for x in samples {
             // ∫ from `left` to x: the nodes of the pieces before x (x is a piece end).
             let before: f64 = table
