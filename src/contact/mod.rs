@@ -1965,9 +1965,9 @@ pub fn graded_nodes(points: Vec<f64>, nodes: impl Fn(f64, f64) -> usize) -> (Vec
 /// With `smooth_nodes`, a piece whose two ends were both made by the balancing (`piece_ends`)
 /// takes a plain Gauss–Legendre rule of that many nodes instead: no point where f is not
 /// smooth ends it, and after the balancing every such point lies at least a third of the
-/// piece's length beyond its ends, so f is analytic inside the Bernstein ellipse with
-/// `ρ ≥ 5/3 + √(16/9 − 1) ≈ 2.55` about the piece, and the n-point rule errs by about
-/// `ρ^(−2n)` (1e−13 for 16 nodes). The sine-graded rule, whose clustering at both ends pulls
+/// piece's length beyond its ends (two thirds of its half-length), so f is analytic inside
+/// the Bernstein ellipse with `ρ ≥ 5/3 + √(25/9 − 1) = 3` about the piece, and the n-point
+/// rule errs by about `ρ^(−2n)` (5e−16 for 16 nodes). The sine-graded rule, whose clustering at both ends pulls
 /// such a point towards the piece in its variable, needs more (`piece_ends`' test: 1.3e−8 with
 /// 32 nodes for a logarithm at a third of the length).
 pub fn graded_cumulative(
