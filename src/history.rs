@@ -1232,6 +1232,17 @@ pub fn continue_run(
     })
 }
 
+/// The driver at the end of the normal loading of scenario `sc` on `disc` (tests' start).
+#[cfg(test)]
+pub(crate) fn driver_after_normal_loading(
+    sc: &crate::scenario::Scenario,
+    disc: &Discretisation,
+) -> DriverState {
+    use crate::contact::normal::{NormalOptions, solve_normal};
+    let normal = solve_normal(&sc.model, disc, sc.normal_load, NormalOptions::default()).unwrap();
+    DriverState::after_normal_loading(&normal)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1242,12 +1253,9 @@ mod tests {
     /// the first two phases of the default history at M = 128.
     #[test]
     fn the_dissipation_rule_gives_the_step_dissipations_to_a_small_error() {
-        use crate::contact::normal::{NormalOptions, solve_normal};
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(128);
-        let normal =
-            solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
-        let mut driver = DriverState::after_normal_loading(&normal);
+        let mut driver = driver_after_normal_loading(&sc, &disc);
         let steps = sc.history.as_ref().expect("default history").steps();
         let fine = (4 * crate::contact::slip_zone_rule_nodes(128), None);
         let graded = crate::contact::slip_zone_rule_nodes(128);

@@ -2445,21 +2445,6 @@ mod tests {
         .unwrap();
     }
 
-    /// The driver of scenario `sc` at the end of its normal loading on `disc`.
-    fn driver_after_normal_loading(
-        sc: &crate::scenario::Scenario,
-        disc: &Discretisation,
-    ) -> crate::history::DriverState {
-        let normal = crate::contact::normal::solve_normal(
-            &sc.model,
-            disc,
-            sc.normal_load,
-            crate::contact::normal::NormalOptions::default(),
-        )
-        .unwrap();
-        crate::history::DriverState::after_normal_loading(&normal)
-    }
-
     /// The forward-slip problem (both slip zones positive) of the default scenario `sc` at the
     /// driver's state, inheriting from `base`, with the given maps and caches.
     fn forward_problem<'a>(
@@ -2870,7 +2855,7 @@ mod tests {
         use crate::history::LoadPoint;
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(sc.collocation_points);
-        let mut driver = driver_after_normal_loading(&sc, &disc);
+        let mut driver = crate::history::driver_after_normal_loading(&sc, &disc);
         let steps = sc.history.as_ref().expect("default history").steps();
         let nodes = crate::contact::slip_check_rule_nodes(disc.nodes());
         let mut worst: f64 = 0.0;
@@ -2903,7 +2888,7 @@ mod tests {
         use crate::history::LoadPoint;
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(128);
-        let mut driver = driver_after_normal_loading(&sc, &disc);
+        let mut driver = crate::history::driver_after_normal_loading(&sc, &disc);
         let steps = sc.history.as_ref().expect("default history").steps();
         let fine = 4 * crate::contact::field_rule_nodes(disc.nodes());
         let (mut rule, mut reference) = (Vec::new(), Vec::new());
