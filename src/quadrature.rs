@@ -212,21 +212,29 @@ impl ColumnMatrix {
 
     fn products(&self, x: &[f64], y: &mut [f64], factor: Option<f64>) {
         debug_assert!(y.len() <= self.rows && x.len() == self.cols);
-        let mut sums = vec![0.0; self.stride];
-        pulp::Arch::new().dispatch(SumColumns {
-            data: &self.data,
-            stride: self.stride,
-            x,
-            sums: &mut sums,
-        });
-        match factor {
-            None => y.copy_from_slice(&sums[..y.len()]),
-            Some(f) => {
-                for (yi, s) in y.iter_mut().zip(&sums) {
-                    *yi += f * s;
+        // The padded sums in this thread's buffer: the products run at every pass of the
+        // tangential solver's inner iteration, which allocates nothing per pass.
+        thread_local! {
+            static SUMS: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        SUMS.with_borrow_mut(|sums| {
+            sums.clear();
+            sums.resize(self.stride, 0.0);
+            pulp::Arch::new().dispatch(SumColumns {
+                data: &self.data,
+                stride: self.stride,
+                x,
+                sums,
+            });
+            match factor {
+                None => y.copy_from_slice(&sums[..y.len()]),
+                Some(f) => {
+                    for (yi, s) in y.iter_mut().zip(sums.iter()) {
+                        *yi += f * s;
+                    }
                 }
             }
-        }
+        });
     }
 }
 
