@@ -1967,9 +1967,9 @@ pub fn graded_nodes(points: Vec<f64>, nodes: impl Fn(f64, f64) -> usize) -> (Vec
 /// smooth ends it, and after the balancing every such point lies at least a third of the
 /// piece's length beyond its ends (two thirds of its half-length), so f is analytic inside
 /// the Bernstein ellipse with `ρ ≥ 5/3 + √(25/9 − 1) = 3` about the piece, and the n-point
-/// rule errs by about `ρ^(−2n)` (5e−16 for 16 nodes). The sine-graded rule, whose clustering at both ends pulls
-/// such a point towards the piece in its variable, needs more (`piece_ends`' test: 1.3e−8 with
-/// 32 nodes for a logarithm at a third of the length).
+/// rule errs by about `ρ^(−2n)` (5e−16 for 16 nodes). The sine-graded rule, whose clustering
+/// at both ends pulls such a point towards the piece in its variable, needs more
+/// (`piece_ends`' test: 1.3e−8 with 32 nodes for a logarithm at a third of the length).
 pub fn graded_cumulative(
     points: Vec<f64>,
     nodes: usize,
