@@ -487,8 +487,8 @@ impl FadeTable {
 /// points in SIMD lanes chosen at run time by `pulp` (four-wide AVX2 where the processor has
 /// it, else two-wide SSE2: the 256-bit divisions that bound these sums halve their time;
 /// points left over from the lanes by [`fade_sum`] itself). Each lane adds the same terms in
-/// the same order as [`fade_sum`], a skipped node −0, so the sums are its own to the bit on
-/// every processor.
+/// the same order as [`fade_sum`], with the same operations, so the sums are its own to the
+/// bit on every processor.
 struct FadeSums<'a> {
     nodes: &'a [(f64, f64, f64)],
     x: &'a [f64],
@@ -505,15 +505,31 @@ impl pulp::WithSimd for FadeSums<'_> {
         let (x_lanes, x_tail) = S::as_simd_f64s(self.x);
         let (cx_lanes, cx_tail) = S::as_simd_f64s(self.cx);
         let (sum_lanes, sum_tail) = S::as_mut_simd_f64s(self.sums);
-        let (tiny, skipped) = (simd.splat_f64s(self.tiny), simd.splat_f64s(-0.0));
+        let tiny = simd.splat_f64s(self.tiny);
+        let (zero, one) = (simd.splat_f64s(0.0), simd.splat_f64s(1.0));
+        let pairs = self.nodes.chunks_exact(2);
+        let single = pairs.remainder();
         for ((x, cx), sum) in x_lanes.iter().zip(cx_lanes).zip(sum_lanes) {
-            let mut acc = *sum;
-            for &(t, wq, chi) in self.nodes {
+            // A node's numerator and distance, a skipped node's as 0 and 1.
+            let term = |&(t, wq, chi): &(f64, f64, f64)| {
                 let d = simd.sub_f64s(simd.splat_f64s(t), *x);
                 let weight = simd.sub_f64s(simd.splat_f64s(chi), *cx);
-                let term = simd.div_f64s(simd.mul_f64s(simd.splat_f64s(wq), weight), d);
                 let keep = simd.greater_than_f64s(simd.abs_f64s(d), tiny);
-                acc = simd.add_f64s(acc, simd.select_f64s(keep, term, skipped));
+                let n = simd.mul_f64s(simd.splat_f64s(wq), weight);
+                (
+                    simd.select_f64s(keep, n, zero),
+                    simd.select_f64s(keep, d, one),
+                )
+            };
+            let mut acc = *sum;
+            for pair in pairs.clone() {
+                let ((n1, d1), (n2, d2)) = (term(&pair[0]), term(&pair[1]));
+                let num = simd.add_f64s(simd.mul_f64s(n1, d2), simd.mul_f64s(n2, d1));
+                acc = simd.add_f64s(acc, simd.div_f64s(num, simd.mul_f64s(d1, d2)));
+            }
+            for node in single {
+                let (n, d) = term(node);
+                acc = simd.add_f64s(acc, simd.div_f64s(n, d));
             }
             *sum = acc;
         }
@@ -524,13 +540,35 @@ impl pulp::WithSimd for FadeSums<'_> {
 }
 
 /// `Σ w q̃_E(t) (χ(t) − χ(x))/(t − x)` over `nodes`, skipping a node within `tiny` of x.
+///
+/// The divisions bound these sums, so the nodes are taken in pairs over a common
+/// denominator, `n₁/d₁ + n₂/d₂ = (n₁d₂ + n₂d₁)/(d₁d₂)` (a skipped node as `n = 0, d = 1`):
+/// one division for two terms, with a rounding error of the same order as the two quotients'
+/// (the distances are at least `tiny`, so their products stay far above f64's smallest
+/// normal number). The forward step at M = 128: 1.008–1.014 → 0.983–0.990 ms (best of 400,
+/// three rounds); four nodes over one denominator were no faster (0.991–0.995 ms).
 #[inline(always)]
 fn fade_sum(nodes: &[(f64, f64, f64)], x: f64, cx: f64, tiny: f64) -> f64 {
-    nodes
-        .iter()
-        .filter(|(t, _, _)| (t - x).abs() > tiny)
-        .map(|(t, wq, chi)| wq * (chi - cx) / (t - x))
-        .sum()
+    let term = |&(t, wq, chi): &(f64, f64, f64)| {
+        let d = t - x;
+        if d.abs() > tiny {
+            (wq * (chi - cx), d)
+        } else {
+            (0.0, 1.0)
+        }
+    };
+    let pairs = nodes.chunks_exact(2);
+    let single = pairs.remainder();
+    let mut acc = -0.0;
+    for pair in pairs {
+        let ((n1, d1), (n2, d2)) = (term(&pair[0]), term(&pair[1]));
+        acc += (n1 * d2 + n2 * d1) / (d1 * d2);
+    }
+    for node in single {
+        let (n, d) = term(node);
+        acc += n / d;
+    }
+    acc
 }
 
 impl PartialEq for Inherited {
