@@ -210,30 +210,46 @@ impl ColumnMatrix {
         }
     }
 
+    /// `y_k = A x_k` for both k (the first `y_k.len()` rows), reading the matrix once.
+    pub fn apply_pair(&self, x: [&[f64]; 2], y: [&mut [f64]; 2]) {
+        debug_assert!(y.iter().all(|y| y.len() <= self.rows));
+        self.with_sums(x, |sums| {
+            for (y, sums) in y.into_iter().zip(sums.chunks_exact(self.stride)) {
+                y.copy_from_slice(&sums[..y.len()]);
+            }
+        });
+    }
+
     fn products(&self, x: &[f64], y: &mut [f64], factor: Option<f64>) {
-        debug_assert!(y.len() <= self.rows && x.len() == self.cols);
-        // The padded sums in this thread's buffer: the products run at every pass of the
-        // tangential solver's inner iteration, which allocates nothing per pass.
+        debug_assert!(y.len() <= self.rows);
+        self.with_sums([x], |sums| match factor {
+            None => y.copy_from_slice(&sums[..y.len()]),
+            Some(f) => {
+                for (yi, s) in y.iter_mut().zip(sums.iter()) {
+                    *yi += f * s;
+                }
+            }
+        });
+    }
+
+    /// `f` of the padded sums `A x_k`, one after the other a stride apart, in this thread's
+    /// buffer: the products run at every pass of the tangential solver's inner iteration,
+    /// which allocates nothing per pass.
+    fn with_sums<const K: usize>(&self, x: [&[f64]; K], f: impl FnOnce(&[f64])) {
+        debug_assert!(x.iter().all(|x| x.len() == self.cols));
         thread_local! {
             static SUMS: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
         }
         SUMS.with_borrow_mut(|sums| {
             sums.clear();
-            sums.resize(self.stride, 0.0);
+            sums.resize(K * self.stride, 0.0);
             pulp::Arch::new().dispatch(SumColumns {
                 data: &self.data,
                 stride: self.stride,
                 x,
                 sums,
             });
-            match factor {
-                None => y.copy_from_slice(&sums[..y.len()]),
-                Some(f) => {
-                    for (yi, s) in y.iter_mut().zip(sums.iter()) {
-                        *yi += f * s;
-                    }
-                }
-            }
+            f(sums);
         });
     }
 }
@@ -323,16 +339,19 @@ fn fill_block<S: pulp::Simd, const B: usize>(
     }
 }
 
-/// The column sums of [`ColumnMatrix::products`], `sums = Σ_n x_n A[:, n]`, eight vectors of
-/// rows at a time (rows left over from the vectors one at a time).
-struct SumColumns<'a> {
+/// The column sums of [`ColumnMatrix::products`] for K vectors at once, `sums_k = Σ_n x_{k,n}
+/// A[:, n]` (`sums` holds the K sums one after the other, a stride apart): each column is read
+/// once for all K, in blocks of `8/K` vectors of rows (8 accumulators), rows left over from the
+/// vectors one at a time. The products are bandwidth-bound (the matrix streams from the
+/// cache), so two vectors at once cost much less than two products.
+struct SumColumns<'a, const K: usize> {
     data: &'a [f64],
     stride: usize,
-    x: &'a [f64],
+    x: [&'a [f64]; K],
     sums: &'a mut [f64],
 }
 
-impl pulp::WithSimd for SumColumns<'_> {
+impl<const K: usize> pulp::WithSimd for SumColumns<'_, K> {
     type Output = ();
 
     #[inline(always)]
@@ -343,51 +362,72 @@ impl pulp::WithSimd for SumColumns<'_> {
             x,
             sums,
         } = self;
-        let (out, out_tail) = S::as_mut_simd_f64s(sums);
-        let whole = out.len();
+        let mut out: [&mut [f64]; K] = {
+            let mut rest = Some(sums);
+            std::array::from_fn(|_| {
+                let (head, tail) = rest.take().expect("K sums").split_at_mut(stride);
+                rest = Some(tail);
+                head
+            })
+        };
+        let whole = stride / S::F64_LANES;
         let mut first = 0;
-        while first + 8 <= whole {
-            sum_block::<S, 8>(simd, data, stride, x, first, out);
-            first += 8;
+        if K == 1 {
+            while first + 8 <= whole {
+                sum_block::<S, 8, K>(simd, data, stride, &x, first, &mut out);
+                first += 8;
+            }
+        } else {
+            while first + 4 <= whole {
+                sum_block::<S, 4, K>(simd, data, stride, &x, first, &mut out);
+                first += 4;
+            }
         }
         while first + 2 <= whole {
-            sum_block::<S, 2>(simd, data, stride, x, first, out);
+            sum_block::<S, 2, K>(simd, data, stride, &x, first, &mut out);
             first += 2;
         }
         if first < whole {
-            sum_block::<S, 1>(simd, data, stride, x, first, out);
+            sum_block::<S, 1, K>(simd, data, stride, &x, first, &mut out);
         }
-        let tail = stride - out_tail.len();
-        for (k, o) in out_tail.iter_mut().enumerate() {
-            *o = data
-                .chunks_exact(stride)
-                .zip(x)
-                .fold(0.0, |acc, (column, xn)| acc + column[tail + k] * xn);
+        let tail = whole * S::F64_LANES;
+        for (sums, x) in out.iter_mut().zip(&x) {
+            for (k, o) in sums[tail..].iter_mut().enumerate() {
+                *o = data
+                    .chunks_exact(stride)
+                    .zip(*x)
+                    .fold(0.0, |acc, (column, xn)| acc + column[tail + k] * xn);
+            }
         }
     }
 }
 
 /// The sums of B vectors of rows from vector `first` on, over every column of [`SumColumns`],
-/// in B accumulators.
+/// for each of its K vectors, in B·K accumulators.
 #[inline(always)]
-fn sum_block<S: pulp::Simd, const B: usize>(
+fn sum_block<S: pulp::Simd, const B: usize, const K: usize>(
     simd: S,
     data: &[f64],
     stride: usize,
-    x: &[f64],
+    x: &[&[f64]; K],
     first: usize,
-    out: &mut [S::f64s],
+    out: &mut [&mut [f64]; K],
 ) {
-    let mut acc = [simd.splat_f64s(0.0); B];
-    for (column, &xn) in data.chunks_exact(stride).zip(x) {
+    let mut acc = [[simd.splat_f64s(0.0); B]; K];
+    for (n, column) in data.chunks_exact(stride).take(x[0].len()).enumerate() {
         let (col, _) = S::as_simd_f64s(column);
         let col = &col[first..first + B];
-        let xn = simd.splat_f64s(xn);
-        for v in 0..B {
-            acc[v] = simd.mul_add_e_f64s(col[v], xn, acc[v]);
+        for (acc, x) in acc.iter_mut().zip(x) {
+            let xn = simd.splat_f64s(x[n]);
+            for v in 0..B {
+                acc[v] = simd.mul_add_e_f64s(col[v], xn, acc[v]);
+            }
         }
     }
-    out[first..first + B].copy_from_slice(&acc);
+    for (acc, out) in acc.iter().zip(out.iter_mut()) {
+        let (out, _) = S::as_mut_simd_f64s(out);
+        out[first..first + B].copy_from_slice(acc);
+    }
 }
 
 /// `Σ a_i b_i` over the common length, in the SIMD lanes of the processor it runs on
@@ -1157,7 +1197,8 @@ mod tests {
     /// The columns' entries are the one-point rows', to the bit (same operations in the same
     /// order), for a count that is not a multiple of four and points inside, on and outside
     /// [−1, 1] (where the density rows vanish); the products are the rows' dot products to
-    /// round-off, and an emptied matrix adds nothing.
+    /// round-off, the products of two vectors at once the single products to the bit, and an
+    /// emptied matrix adds nothing.
     #[test]
     fn column_matrix_holds_the_one_point_rows() {
         let m = 37;
@@ -1217,6 +1258,17 @@ mod tests {
             &mut row,
             "Cauchy transform",
         );
+        // Two vectors at once: each the one-vector product to the bit (the same multiply–adds
+        // per row in the same order), over rows in blocks of every size.
+        let many: Vec<f64> = (0..45).map(|i| -0.99 + 0.044 * i as f64).collect();
+        a.refill(m, &many, UnboundedSeries::density_start);
+        let x2: Vec<f64> = x.iter().map(|v| v * v - 0.3).collect();
+        let (mut y1, mut y2) = (vec![0.0; many.len()], vec![0.0; many.len()]);
+        let (mut z1, mut z2) = (vec![0.0; many.len()], vec![0.0; many.len()]);
+        a.apply(&x, &mut y1);
+        a.apply(&x2, &mut y2);
+        a.apply_pair([&x, &x2], [&mut z1, &mut z2]);
+        assert!(same(&y1, &z1) && same(&y2, &z2), "products of two vectors");
         a.clear();
         let mut y = vec![1.5; 3];
         a.add_apply(&x, 2.0, &mut y);
