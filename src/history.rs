@@ -1038,10 +1038,11 @@ fn step_dissipation_with(
     // for its traction and strain.
     let mean_and_change = |xs: &[f64], out: &mut Vec<f64>, changes: &mut Vec<f64>| {
         let fields = |state: &ContactState| {
-            let (mut p, mut q, mut strain) = (Vec::new(), Vec::new(), Vec::new());
-            state.pressures_into(xs, &mut p);
+            let (mut p, mut h, mut q, mut strain) =
+                (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            state.pressures_and_cauchys_into(xs, &mut p, &mut h);
             state.tractions_with(xs, &p, &mut q);
-            state.strains_with(model, xs, &p, &mut strain);
+            state.strains_with(model, xs, (&p, &h), &mut strain);
             (q, strain)
         };
         let ((q_new, strain_new), (q_old, strain_old)) = (fields(new), fields(old));

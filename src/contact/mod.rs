@@ -1639,6 +1639,31 @@ impl ContactState {
         self.contact_series_into(xs, many, one, extra, out);
     }
 
+    /// [`Self::pressures_into`] and [`Self::pressure_cauchys_into`] at once (bit-identical to
+    /// each), the series' sums from one run of their chains
+    /// ([`BoundedSeries::densities_and_cauchys`]).
+    pub fn pressures_and_cauchys_into(&self, xs: &[f64], p: &mut Vec<f64>, h: &mut Vec<f64>) {
+        let (series, kinks) = (&self.pressure, &self.pressure_kinks);
+        p.clear();
+        h.clear();
+        let mut chunks = xs.chunks_exact(OWN_LANES);
+        for c in chunks.by_ref() {
+            let tau: [f64; OWN_LANES] = std::array::from_fn(|l| self.tau(c[l]));
+            let (density, cauchy) = series.densities_and_cauchys(tau);
+            p.extend(density);
+            h.extend(cauchy);
+        }
+        for &x in chunks.remainder() {
+            let ([density], [cauchy]) = series.densities_and_cauchys([self.tau(x)]);
+            p.push(density);
+            h.push(cauchy);
+        }
+        for ((p, h), &x) in p.iter_mut().zip(h.iter_mut()).zip(xs) {
+            *p += self.kinks_at(kinks, x);
+            *h += self.kinks_with(kinks, |u, v| half_ellipse_cauchy(x, u, v));
+        }
+    }
+
     /// [`Self::traction_at`] at each of `xs` into `out` (bit-identical, in batches).
     pub fn tractions_into(&self, xs: &[f64], out: &mut Vec<f64>) {
         let mut p = Vec::new();
@@ -1789,19 +1814,25 @@ impl ContactState {
     /// [`Self::strain_at`] at each of `xs` into `out` (bit-identical; `H'q̃` of the stick
     /// zone's chain in a batch, [`StickZone::correction_cauchys_into`]).
     pub fn strains_into(&self, model: &ContactModel, xs: &[f64], out: &mut Vec<f64>) {
-        let mut p = Vec::new();
-        self.pressures_into(xs, &mut p);
-        self.strains_with(model, xs, &p, out);
+        let (mut p, mut p_cauchy) = (Vec::new(), Vec::new());
+        self.pressures_and_cauchys_into(xs, &mut p, &mut p_cauchy);
+        self.strains_with(model, xs, (&p, &p_cauchy), out);
     }
 
-    /// [`Self::strains_into`] given the pressure `p` at `xs` (as from [`Self::pressures_into`]).
-    pub fn strains_with(&self, model: &ContactModel, xs: &[f64], p: &[f64], out: &mut Vec<f64>) {
+    /// [`Self::strains_into`] given the pressure and its Cauchy transform at `xs` (as from
+    /// [`Self::pressures_and_cauchys_into`]).
+    pub fn strains_with(
+        &self,
+        model: &ContactModel,
+        xs: &[f64],
+        (p, p_cauchy): (&[f64], &[f64]),
+        out: &mut Vec<f64>,
+    ) {
         out.clear();
         let mut w = Vec::new();
         self.potential_charges_into(xs, &mut w);
-        let (mut p_cauchy, mut chain) = (Vec::new(), Vec::new());
+        let mut chain = Vec::new();
         if let Some(stick) = &self.traction.stick {
-            self.pressure_cauchys_into(xs, &mut p_cauchy);
             stick.correction_cauchys_into(xs, &mut chain);
         }
         let w13 = model.compliance.electric.map_or(0.0, |e| e.w13);

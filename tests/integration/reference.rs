@@ -988,8 +988,14 @@ fn cycle_verdicts() {
 /// slip states are tried, the guesses) would break it. Measured at the solver tolerance 1e−11
 /// (twenty-fourth session): stick ends to 4.0e−12 a, e and a to 3.4e−13 a, δ to 1.4e−11 and
 /// the dissipation to 2.0e−11 of their largest values (at the tolerance 1e−13 of the twelfth
-/// session: 1.3e−13 a, 1.6e−14 a, 1.7e−13 and 9.7e−13, round-off). Bounds: the geometry ten
-/// times the solver's tolerance, δ and the dissipation 1e−10.
+/// session: 1.3e−13 a, 1.6e−14 a, 1.7e−13 and 9.7e−13, round-off). With the twenty-fifth
+/// session's Cauchy sums (the same sums, other round-off) the two runs' iterates land
+/// elsewhere below the tolerance: stick ends to 1.4e−11 a, e and a to 1.4e−12 a, δ to
+/// 1.5e−11, the dissipation to 1.5e−10. The dissipation of a step moves about ten times its
+/// stick ends (7.5 and 10.6 at the two tolerances: it integrates strain changes over slip zones
+/// a few hundredths of a wide), so its bound is ten times the geometry's, as in the other
+/// tests that compare two paths to one state (`assert_same_states`). Bounds: the geometry ten
+/// times the solver's tolerance, δ 1e−10, the dissipation a hundred times the tolerance.
 #[test]
 fn history_is_mirror_symmetric() {
     let Baseline {
@@ -1038,12 +1044,14 @@ fn history_is_mirror_symmetric() {
     }
     eprintln!("mirror mismatch (lo, hi, e, a, δ, dissipation): {worst:?}");
     // The solver's tolerance: the geometry to ten times it (relative to a); δ (a sum of
-    // differences of quadratures) and the dissipation to 1e−10 of their largest values.
+    // differences of quadratures) to 1e−10 of its largest value, the dissipation to a hundred
+    // times the tolerance.
     assert!(
         worst[..4].iter().all(|w| *w < 10.0 * solver_tolerance()),
         "{worst:?}"
     );
-    assert!(worst[4..].iter().all(|w| *w < 1e-10), "{worst:?}");
+    assert!(worst[4] < 1e-10, "{worst:?}");
+    assert!(worst[5] < 100.0 * solver_tolerance(), "{worst:?}");
 }
 
 /// Every stick zone of a history lies inside the contact; within a phase an end next to a
