@@ -454,11 +454,11 @@ struct FadeTable {
 }
 
 impl FadeTable {
-    /// The table of the nodes `(t, w q̃_E(t), χ(t))`, on pieces ended by `ramps`' points.
-    fn new(mut all: Vec<(f64, f64, f64)>, ramps: [Option<(f64, f64)>; 2]) -> Self {
-        // In increasing t (the rules' nodes decrease on each piece): `FadeSums` finds the
-        // nodes near a point by bisection.
-        all.sort_by(|a, b| a.0.total_cmp(&b.0));
+    /// The table of the nodes `(t, w q̃_E(t), χ(t))` in increasing t, on pieces ended by
+    /// `ramps`' points.
+    fn new(all: Vec<(f64, f64, f64)>, ramps: [Option<(f64, f64)>; 2]) -> Self {
+        // `FadeSums` finds the nodes near a point by bisection.
+        debug_assert!(all.is_sorted_by(|a, b| a.0 <= b.0), "nodes in increasing t");
         let except = |v: f64| {
             all.iter()
                 .copied()
@@ -682,9 +682,10 @@ impl Inherited {
             let (nodes, weights) = (&rule.nodes, &rule.weights);
             let mut points = Vec::new();
             let mut scaled_weights = Vec::new();
+            // In increasing t: the pieces increase, the rule's nodes decrease.
             for w in self.pieces().windows(2) {
                 let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-                for (u, wt) in nodes.iter().zip(weights) {
+                for (u, wt) in nodes.iter().zip(weights).rev() {
                     points.push(mid + half * u);
                     scaled_weights.push(wt * half);
                 }
