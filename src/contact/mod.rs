@@ -967,11 +967,14 @@ pub struct RememberedRoot {
 /// `(1/π)⨍ k(t)/(t − u) dt = |u| − 2/π` on (−1, 1). Its U-series coefficients decay only like
 /// n⁻², so it is kept in closed form; `k(u)/√(1−u²) → −2/π` at u = ±1.
 pub fn kink_density(u: f64) -> f64 {
-    if u.abs() >= 1.0 || u == 0.0 {
+    // k(u) ≈ −(2u/π) ln(2/|u|) → 0 as u → 0: below 1e−300 it is 0 to f64's resolution of
+    // k's values (at most 0.47), and the quotient below would overflow.
+    if u.abs() >= 1.0 || u.abs() < 1e-300 {
         return 0.0;
     }
-    // artanh √(1 − u²) = ln((1 + √(1 − u²))/|u|), finite for every u ≠ 0.
-    -2.0 * u / std::f64::consts::PI * ((1.0 + (1.0 - u * u).sqrt()).ln() - u.abs().ln())
+    // artanh √(1 − u²) = ln((1 + √(1 − u²))/|u|): one logarithm (two, of the numerator and of
+    // |u|, made the forward step at M = 128 1 % slower, 0.894–0.896 against 0.885–0.888 ms).
+    -2.0 * u / std::f64::consts::PI * ((1.0 + (1.0 - u * u).sqrt()) / u.abs()).ln()
 }
 
 /// `(1/π)⨍ k(t)/(t − u) dt`: `|u| − 2/π` inside, `(2/π)((|z| + 1/|z|) arctan|z| − 1)` outside,
@@ -2801,6 +2804,28 @@ mod tests {
                 (got - expected).abs() < 1e-14,
                 "x = {x}, d = {d}: {got} vs {expected}"
             );
+        }
+    }
+
+    /// `k(u)` with one logarithm equals the definition `−(2u/π)(ln(1 + √(1−u²)) − ln|u|)`
+    /// to round-off across (−1, 1) (measured 1.1e−16 at worst, k being at most 0.47; bound
+    /// 1e−15), and is 0 at and beyond the ends, at 0, and below 1e−300, where the definition
+    /// is at most 4.4e−298 and the quotient would overflow.
+    #[test]
+    fn kink_density_with_one_logarithm_is_the_definition() {
+        let two_logs = |u: f64| {
+            -2.0 * u / std::f64::consts::PI * ((1.0 + (1.0 - u * u).sqrt()).ln() - u.abs().ln())
+        };
+        let mut worst: f64 = 0.0;
+        for k in 1..2000 {
+            let u = -1.0 + k as f64 / 1000.0;
+            for u in [u, u * 1e-3, u * 1e-9, u * 1e-150, u * 1e-299] {
+                worst = worst.max((kink_density(u) - two_logs(u)).abs());
+            }
+        }
+        assert!(worst < 1e-15, "{worst:e}");
+        for u in [-1.0, 1.0, 1.5, 0.0, 1e-301, -3e-310, 5e-324] {
+            assert!(kink_density(u).abs() <= 0.0, "at {u:e}");
         }
     }
 
