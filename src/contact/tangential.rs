@@ -33,10 +33,11 @@
 //! acceleration; the parts that depend only on the geometry (the remembered strain, the
 //! inherited correction and its Cauchy transform, the slip-shape function, and the matrices
 //! that map series coefficients to values at the other unknowns' points, `InnerMaps`) are
-//! built once per evaluation, so that a pass of the iteration is three matrix–vector products
-//! and five fast cosine and sine transforms (the collocation solves and the pressure at the
-//! collocation points, which are Chebyshev transforms over the grids' points,
-//! [`crate::quadrature`]). The inner iteration starts from
+//! built once per evaluation, so that a pass of the iteration is two matrix sweeps (the stick
+//! rows of p, w and `H'p` from one matrix of `T_n` values applied to two coefficient vectors,
+//! and q̃'s own rows at the sample points) and five fast cosine and sine transforms (the
+//! collocation solves and the pressure at the collocation points, which are Chebyshev
+//! transforms over the grids' points, [`crate::quadrature`]). The inner iteration starts from
 //! the previous iterate's coefficients and is solved only as far as the outer iteration needs:
 //! to 1e−3 of the residual being reduced (an inexact Newton method, `inner_tolerance`), and
 //! to 1e−14 for the residual that is accepted; a trial iterate from a residual within 1e4 of
