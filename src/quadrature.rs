@@ -963,7 +963,7 @@ impl BoundedSeries {
     }
 
     /// [`Self::cauchy`] at each of `L` points: inside, −Σ_{n≥1} β_n T_n(τ) from the two-step
-    /// Clenshaw chains of ψ ([`clenshaw_pairs`]; not run when every point is outside), each
+    /// Clenshaw chains of ψ (`clenshaw_pairs`; not run when every point is outside), each
     /// point's sums bit-identical to one point at a time; outside, `−z Σ β_n z^{n−1}` with the
     /// exterior variable z. ([`Self::densities_and_cauchys`] gives the density from the same
     /// chains.)
