@@ -518,20 +518,37 @@ impl pulp::WithSimd for FadeSums<'_> {
         let mul = |a, b| simd.mul_f64s(a, b);
         let add = |a, b| simd.add_f64s(a, b);
         // The (vector, group) pairs with a node within twice `tiny` of one of the vector's
-        // points, increasing: one bisection per point (the nodes increase), a point rarely has
-        // any.
+        // points, increasing (a point rarely has any). The nodes increase; for points in
+        // order (the stick points, the rules' nodes) one walk along both finds each point's
+        // first node at or beyond `x − 2 tiny`, otherwise a bisection per point does (the
+        // bisections took 1.8 % of the bench's forward step at M = 128).
         let lanes = S::F64_LANES;
         let reach = 2.0 * self.tiny;
+        let points = &self.x[..x_lanes.len() * lanes];
         let mut near_all: Vec<(usize, usize)> = Vec::new();
-        for (i, &xi) in self.x[..x_lanes.len() * lanes].iter().enumerate() {
-            let from = self.nodes.partition_point(|n| n.0 < xi - reach);
-            for k in from..self.nodes.len() {
-                if self.nodes[k].0 > xi + reach {
+        let mut mark_from = |i: usize, from: usize| {
+            for (k, node) in self.nodes.iter().enumerate().skip(from) {
+                if node.0 > points[i] + reach {
                     break;
                 }
                 if k / FADE_GROUP < count {
                     near_all.push((i / lanes, k / FADE_GROUP));
                 }
+            }
+        };
+        let increasing = points.is_sorted();
+        if increasing || points.iter().rev().is_sorted() {
+            let mut from = 0;
+            for j in 0..points.len() {
+                let i = if increasing { j } else { points.len() - 1 - j };
+                while from < self.nodes.len() && self.nodes[from].0 < points[i] - reach {
+                    from += 1;
+                }
+                mark_from(i, from);
+            }
+        } else {
+            for (i, &xi) in points.iter().enumerate() {
+                mark_from(i, self.nodes.partition_point(|n| n.0 < xi - reach));
             }
         }
         near_all.sort_unstable();
@@ -2831,7 +2848,9 @@ mod tests {
 
     /// The fade sums in SIMD lanes are the one-point sums to the bit, with points that lie on
     /// a node, within `tiny` of one, within twice `tiny` (the masked groups) and elsewhere, in
-    /// vectors and in the lanes' tail; a node on a point is left out (the sum stays finite).
+    /// vectors and in the lanes' tail, in no order and in increasing and decreasing order (the
+    /// two ways of finding the near nodes); a node on a point is left out (the sum stays
+    /// finite).
     #[test]
     fn fade_sums_in_lanes_equal_the_one_point_sums() {
         let tiny = 1e-14;
@@ -2855,27 +2874,37 @@ mod tests {
             0.31,
             on(17),
         ];
-        let cx: Vec<f64> = x.iter().map(|t| 0.4 + 0.3 * t).collect();
-        let mut sums = vec![-0.0; x.len()];
-        pulp::Arch::new().dispatch(FadeSums {
-            nodes: &nodes,
-            x: &x,
-            cx: &cx,
-            tiny,
-            sums: &mut sums,
-        });
-        for ((&xi, &ci), &sum) in x.iter().zip(&cx).zip(&sums) {
-            let one = fade_sum(&nodes, xi, ci, tiny);
-            assert_eq!(sum.to_bits(), one.to_bits(), "at {xi}: {sum} vs {one}");
-            assert!(sum.is_finite(), "at {xi}");
+        let chi = |t: f64| 0.4 + 0.3 * t;
+        let lanes = |x: &[f64]| {
+            let cx: Vec<f64> = x.iter().map(|&t| chi(t)).collect();
+            let mut sums = vec![-0.0; x.len()];
+            pulp::Arch::new().dispatch(FadeSums {
+                nodes: &nodes,
+                x,
+                cx: &cx,
+                tiny,
+                sums: &mut sums,
+            });
+            sums
+        };
+        // In no order (a bisection per point), increasing and decreasing (one walk).
+        let mut increasing = x.clone();
+        increasing.sort_by(f64::total_cmp);
+        let decreasing: Vec<f64> = increasing.iter().rev().copied().collect();
+        for points in [&x, &increasing, &decreasing] {
+            for (&xi, &sum) in points.iter().zip(&lanes(points)) {
+                let one = fade_sum(&nodes, xi, chi(xi), tiny);
+                assert_eq!(sum.to_bits(), one.to_bits(), "at {xi}: {sum} vs {one}");
+                assert!(sum.is_finite(), "at {xi}");
+            }
         }
         // The skipped node is really left out: against the sum without it.
         let rest: Vec<_> = [&nodes[..3], &nodes[4..]].concat();
-        let without = fade_sum(&rest, x[0], cx[0], tiny);
+        let without = fade_sum(&rest, x[0], chi(x[0]), tiny);
+        let with_lanes = lanes(&x)[0];
         assert!(
-            (sums[0] - without).abs() < 1e-13 * without.abs(),
-            "{} vs {without}",
-            sums[0]
+            (with_lanes - without).abs() < 1e-13 * without.abs(),
+            "{with_lanes} vs {without}"
         );
     }
 
