@@ -355,16 +355,29 @@ impl ChainTable {
     }
 
     /// [`Self::at`] at each of `xs` into `out`, `fallback(x)` outside the table (bit-identical;
-    /// four consecutive points on one piece share a four-point sum).
+    /// eight, else four, consecutive points on one piece share one sum, their recurrences
+    /// interleaved: eight instead of four made the bench's forward step at M = 128 2.4 %
+    /// faster, best of 150 in eight rounds 0.882–0.887 → 0.861–0.865 ms; each point's piece is
+    /// found once).
     fn values_into(&self, xs: &[f64], fallback: impl Fn(f64) -> f64, out: &mut Vec<f64>) {
+        let pieces: Vec<Option<usize>> = xs.iter().map(|&x| self.piece(x)).collect();
+        let run = |k: usize, len: usize| {
+            pieces[k].is_some()
+                && k + len <= xs.len()
+                && pieces[k + 1..k + len].iter().all(|p| *p == pieces[k])
+        };
         let mut k = 0;
         while k < xs.len() {
-            let piece = self.piece(xs[k]);
-            let same = piece.is_some()
-                && k + 4 <= xs.len()
-                && xs[k + 1..k + 4].iter().all(|&x| self.piece(x) == piece);
-            match piece {
-                Some(p) if same => {
+            match pieces[k] {
+                Some(p) if run(k, 8) => {
+                    let v: [f64; 8] = std::array::from_fn(|l| self.graded(p, xs[k + l]));
+                    out.extend(crate::quadrature::chebyshev_t_sums(
+                        &self.coefficients[p],
+                        v,
+                    ));
+                    k += 8;
+                }
+                Some(p) if run(k, 4) => {
                     let v: [f64; 4] = std::array::from_fn(|l| self.graded(p, xs[k + l]));
                     out.extend(crate::quadrature::chebyshev_t_sums(
                         &self.coefficients[p],
