@@ -1736,13 +1736,10 @@ impl ContactState {
         self.contact_series_into(xs, many, one, |x| self.kinks_at(kinks, x), out);
     }
 
-    /// [`Self::pressure_cauchy`] at each of `xs` into `out` (bit-identical).
+    /// [`Self::pressure_cauchy`] at each of `xs` into `out` (bit-identical; the transform of
+    /// [`Self::pressures_and_cauchys_into`], one code path for both).
     pub fn pressure_cauchys_into(&self, xs: &[f64], out: &mut Vec<f64>) {
-        let (series, kinks) = (&self.pressure, &self.pressure_kinks);
-        let many = |t| series.cauchys(t);
-        let one = |t| series.cauchy(t);
-        let extra = |x| self.kinks_with(kinks, |u, v| half_ellipse_cauchy(x, u, v));
-        self.contact_series_into(xs, many, one, extra, out);
+        self.pressures_and_cauchys_into(xs, &mut Vec::new(), out);
     }
 
     /// [`Self::pressures_into`] and [`Self::pressure_cauchys_into`] at once (bit-identical to
