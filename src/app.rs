@@ -10,7 +10,7 @@ use crate::contact::tangential::SlipOptions;
 use crate::contact::{ContactModel, SurfacePoint};
 use crate::error::Error;
 use crate::halfplane::{PaperCoefficients, SurfaceCompliance, SurfaceFieldCoefficients};
-use crate::output::{Staging, csv_bytes};
+use crate::output::{Protected, RunFolder, SweepFolder, csv_bytes};
 use crate::scenario::{RawScenario, Scenario};
 
 /// Constants derived from the material, reported in `summary.json`.
@@ -145,9 +145,11 @@ fn normal_summary(model: &ContactModel, n: &NormalLoading) -> NormalSummary {
     }
 }
 
-/// Solve a validated scenario and write its outputs into `out_dir` (replacing it).
+/// Solve a validated scenario and write its outputs into `out_dir`, which must be new or a
+/// previous fretsim output ([`RunFolder::claim`]).
 pub fn run(scenario: &Scenario, out_dir: &Path) -> Result<RunResult, Error> {
-    run_with(scenario, out_dir, &mut crate::history::NoObserver)
+    let folder = RunFolder::claim(out_dir, &Protected::new(None))?;
+    run_with(scenario, folder, &mut crate::history::NoObserver)
 }
 
 /// Summary of the tangential history, in `summary.json`.
@@ -311,30 +313,38 @@ fn solver_statistics(
 /// As [`run`], reporting each accepted step to `observer` (progress bars).
 pub fn run_with(
     scenario: &Scenario,
-    out_dir: &Path,
+    folder: RunFolder,
     observer: &mut dyn crate::history::Observer,
 ) -> Result<RunResult, Error> {
-    match run_partial(scenario, out_dir, observer)? {
+    match run_partial(scenario, folder, observer)? {
         (result, None) => Ok(result),
         (_, Some(failure)) => Err(failure),
     }
 }
 
 /// As [`run_with`], but a solver failure during the history is returned beside what was
-/// written (the summary and the fields reached) instead of replacing it. Errors before the
-/// history (normal loading, writing) are returned as `Err`.
+/// written (the summary and the fields reached) instead of replacing it. A failure of the
+/// normal loading is returned as `Err` after `failure.json` is written; so is a write error.
 pub fn run_partial(
     scenario: &Scenario,
-    out_dir: &Path,
+    mut folder: RunFolder,
     observer: &mut dyn crate::history::Observer,
 ) -> Result<(RunResult, Option<Error>), Error> {
+    crate::output::pause_point("solve");
     let model = &scenario.model;
     let disc = Discretisation::new(scenario.collocation_points);
-    let normal = solve_normal(model, &disc, scenario.normal_load, NormalOptions::default())
-        .map_err(|failure| Error::Solve {
-            context: "normal loading".into(),
-            failure,
-        })?;
+    let normal = match solve_normal(model, &disc, scenario.normal_load, NormalOptions::default()) {
+        Ok(normal) => normal,
+        Err(failure) => {
+            let error = Error::Solve {
+                context: "normal loading".into(),
+                failure,
+            };
+            folder.write("failure.json", &failure_json(&error, None))?;
+            folder.commit()?;
+            return Err(error);
+        }
+    };
     let mut warnings = Vec::new();
     let gamma1 = model.pressure_charge(scenario.normal_load);
     let gap = model.outside_gap(&normal.state);
@@ -480,14 +490,9 @@ pub fn run_partial(
         turning.extend(snapshots.kept.iter());
         turning.extend(snapshots.previous.iter());
     }
-    let staging = Staging::new(out_dir)?;
-    let mut written = Vec::new();
-    let result = (|| {
-        let mut put = |name: String, bytes: &[u8]| -> Result<(), Error> {
-            staging.write(&name, bytes)?;
-            written.push(name);
-            Ok(())
-        };
+    let mut sections = Vec::new();
+    {
+        let mut put = |name: String, bytes: &[u8]| folder.write(&name, bytes);
         put(
             "summary.json".into(),
             &serde_json::to_vec_pretty(&summary).expect("summary serialises"),
@@ -505,7 +510,6 @@ pub fn run_partial(
                 &fields_csv(&sample(state)),
             )?;
         }
-        let mut sections = Vec::new();
         let mut section = |title: &str, plots: Vec<(String, String)>| -> Result<(), Error> {
             let mut names = Vec::new();
             for (name, svg) in plots {
@@ -533,40 +537,34 @@ pub fn run_partial(
             "Fields at the snapshot instants",
             family_plots("snapshots", "at the snapshot instants", &instants),
         )?;
-        if let Some(e) = &failure {
-            let body = serde_json::json!({
-                "error": e.to_string(),
-                "last_accepted_step": records.last(),
-            });
-            put(
-                "failure.json".into(),
-                &serde_json::to_vec_pretty(&body).expect("serialises"),
-            )?;
-        }
-        written.sort();
-        staging.write(
-            "index.html",
-            index_html(&scenario.name, &sections, &written).as_bytes(),
-        )?;
-        Ok::<(), Error>(())
-    })();
-    match result {
-        Ok(()) => {
-            let out_dir = staging.commit()?;
-            Ok((
-                RunResult {
-                    out_dir,
-                    summary,
-                    fields,
-                },
-                failure,
-            ))
-        }
-        Err(e) => {
-            staging.abandon();
-            Err(e)
-        }
     }
+    if let Some(e) = &failure {
+        folder.write("failure.json", &failure_json(e, records.last()))?;
+    }
+    let mut written = folder.files().to_vec();
+    written.sort();
+    folder.write(
+        "index.html",
+        index_html(&scenario.name, &sections, &written).as_bytes(),
+    )?;
+    let out_dir = folder.commit()?;
+    Ok((
+        RunResult {
+            out_dir,
+            summary,
+            fields,
+        },
+        failure,
+    ))
+}
+
+/// `failure.json`: the error and the last accepted step (none when normal loading failed).
+fn failure_json(error: &Error, last: Option<&crate::history::StepRecord>) -> Vec<u8> {
+    let body = serde_json::json!({
+        "error": error.to_string(),
+        "last_accepted_step": last,
+    });
+    serde_json::to_vec_pretty(&body).expect("serialises")
 }
 
 /// The plots of the fields at the end of normal loading.
@@ -1018,6 +1016,23 @@ pub struct SweepOutput {
     pub variants: usize,
     /// Variants whose solve failed (their `error` column is filled).
     pub failed: usize,
+    /// The `failure.json` files of the failed variants (with [`SweepOptions::runs`]).
+    pub failure_files: Vec<PathBuf>,
+}
+
+impl SweepOutput {
+    /// The sweep as an error when any variant failed (exit status 1).
+    pub fn check(self) -> Result<Self, Error> {
+        if self.failed == 0 {
+            return Ok(self);
+        }
+        Err(Error::SweepFailed {
+            failed: self.failed,
+            variants: self.variants,
+            csv: self.csv,
+            failure_files: self.failure_files,
+        })
+    }
 }
 
 /// The folder of variant `index` of a sweep run with [`SweepOptions::runs`].
@@ -1117,16 +1132,28 @@ pub fn sweep(
     vary: &[Vary],
     options: SweepOptions,
     out_dir: &Path,
+    protected: &Protected,
     on_variant: &(dyn Fn() + Sync),
 ) -> Result<SweepOutput, Error> {
     let scenarios = sweep_variants(text, source, vary, options.shard)?;
+    let name = match options.shard {
+        Some(s) => format!("sweep-{}-of-{}.csv", s.index, s.count),
+        None => "sweep.csv".to_string(),
+    };
+    let folder = SweepFolder::claim(out_dir, &name, protected)?;
+    if options.runs {
+        for (i, _, _) in &scenarios {
+            RunFolder::check(&out_dir.join(variant_dir(*i)), protected)?;
+        }
+    }
     use rayon::prelude::*;
     let mut outcomes: Vec<VariantOutcome> = scenarios
         .par_iter()
         .map(|(i, _, sc)| {
             let outcome = if options.runs {
                 let dir = out_dir.join(variant_dir(*i));
-                match run_partial(sc, &dir, &mut crate::history::NoObserver) {
+                let claimed = RunFolder::claim(&dir, protected);
+                match claimed.and_then(|f| run_partial(sc, f, &mut crate::history::NoObserver)) {
                     // A history that stops part-way keeps its normal loading and the fields
                     // reached.
                     Ok((r, error)) => VariantOutcome {
@@ -1164,10 +1191,12 @@ pub fn sweep(
         .collect();
     // An output folder that cannot be written stops the sweep (exit 2); solver failures are
     // reported per variant.
-    if let Some(k) = outcomes
-        .iter()
-        .position(|o| matches!(o.error, Some(Error::WriteOutput { .. })))
-        && let Some(e) = outcomes.swap_remove(k).error
+    if let Some(k) = outcomes.iter().position(|o| {
+        matches!(
+            o.error,
+            Some(Error::WriteOutput { .. } | Error::OutputRefused { .. })
+        )
+    }) && let Some(e) = outcomes.swap_remove(k).error
     {
         return Err(e);
     }
@@ -1210,11 +1239,7 @@ pub fn sweep(
         row.push(o.error.as_ref().map(|e| e.to_string()).unwrap_or_default());
         w.write_record(&row).expect("in-memory write");
     }
-    let name = match options.shard {
-        Some(s) => format!("sweep-{}-of-{}.csv", s.index, s.count),
-        None => "sweep.csv".to_string(),
-    };
-    let csv_path = out_dir.join(&name);
+    let csv_path = folder.dir().join(&name);
     crate::output::write_atomic(&csv_path, &w.into_inner().expect("in-memory write"))?;
     if options.runs && options.shard.is_none() {
         write_comparison(vary, &scenarios, &outcomes, out_dir, &name)?;
@@ -1223,6 +1248,13 @@ pub fn sweep(
         csv: csv_path,
         variants: outcomes.len(),
         failed: outcomes.iter().filter(|o| o.error.is_some()).count(),
+        failure_files: scenarios
+            .iter()
+            .zip(&outcomes)
+            .filter(|(_, o)| options.runs && o.error.is_some())
+            .map(|((i, _, _), _)| out_dir.join(variant_dir(*i)).join("failure.json"))
+            .filter(|p| p.is_file())
+            .collect(),
     })
 }
 

@@ -38,6 +38,14 @@ fn list(issues: &[Issue]) -> String {
         .join("\n")
 }
 
+fn failure_list(files: &[PathBuf]) -> String {
+    if files.is_empty() {
+        return String::new();
+    }
+    let names: Vec<String> = files.iter().map(|f| format!("  {}", f.display())).collect();
+    format!(" and in:\n{}", names.join("\n"))
+}
+
 /// Why a solve failed. Carried inside [`Error::Solve`] with the step context.
 #[derive(Debug, Clone, PartialEq, thiserror::Error, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
@@ -118,6 +126,31 @@ pub enum Error {
         /// What failed.
         failure: SolveFailure,
     },
+    /// Some variants of a sweep failed (the others were written).
+    #[error(
+        "{failed} of {variants} variant(s) failed; their errors are in the `error` column of {}{}",
+        csv.display(),
+        failure_list(failure_files)
+    )]
+    SweepFailed {
+        /// Variants that failed.
+        failed: usize,
+        /// Variants run.
+        variants: usize,
+        /// The sweep's CSV file.
+        csv: PathBuf,
+        /// Their `failure.json` files (sweeps with runs).
+        failure_files: Vec<PathBuf>,
+    },
+    /// The output folder may not be written (it holds files fretsim did not write, it is a
+    /// protected folder, or another run is writing it). Nothing was touched.
+    #[error("will not write into {path}: {reason}")]
+    OutputRefused {
+        /// The folder as given.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
     /// An output file could not be written.
     #[error("cannot write {path}: {source}")]
     WriteOutput {
@@ -133,10 +166,11 @@ impl Error {
     /// Process exit code: 1 when the solver failed on valid input, 2 for bad input or usage.
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Solve { .. } => 1,
+            Error::Solve { .. } | Error::SweepFailed { .. } => 1,
             Error::ReadScenario { .. }
             | Error::ParseScenario { .. }
             | Error::InvalidScenario { .. }
+            | Error::OutputRefused { .. }
             | Error::WriteOutput { .. } => 2,
         }
     }

@@ -1,13 +1,13 @@
 //! The `fretsim` command: parse arguments, call the library, map errors to exit codes
 //! (0 success, 1 the solver failed on a valid scenario, 2 bad input or usage).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Parser;
 use fretsim::cli::{Cli, Command};
 use fretsim::error::Error;
-use fretsim::{app, material, scenario};
+use fretsim::{app, material, output, scenario};
 
 /// mimalloc instead of the system allocator: the bench's forward step at M = 128 makes about
 /// 2700 allocations (2.2 MB in all: the per-evaluation point lists, maps and batches), and
@@ -71,126 +71,237 @@ impl fretsim::history::Observer for Progress {
 fn dispatch(command: Command) -> Result<(), Error> {
     match command {
         Command::Run {
-            scenario: path,
+            scenario,
             out,
             quiet,
-        } => {
-            let sc = match &path {
-                Some(p) => scenario::load(p)?,
-                None => scenario::default_scenario(),
-            };
-            let out = out.unwrap_or_else(|| PathBuf::from("output").join(&sc.name));
-            let total = sc.history.as_ref().map_or(0, |h| h.steps().len() as u64);
-            let mut progress = Progress::new(total, quiet);
-            let result = app::run_with(&sc, &out, &mut progress);
-            progress.finish();
-            let result = result?;
-            if !quiet {
-                let n = &result.summary.normal_loading;
-                println!(
-                    "{}: a = {:.6e} m, b/a = {:.6}, C = {:.6e} 1/m, p0 = {:.6e} Pa -> {}",
-                    sc.name,
-                    n.half_width,
-                    n.stick_ratio,
-                    n.strain_slope,
-                    n.peak_pressure,
-                    result.out_dir.display()
-                );
-                for w in &result.summary.warnings {
-                    eprintln!("fretsim: warning: {w}");
-                }
-            }
-            Ok(())
-        }
+        } => run(scenario, out, quiet),
         Command::Sweep {
-            scenario: path,
+            scenario,
             vary,
             out,
             shard,
             runs,
             quiet,
-        } => {
-            let sc = scenario::load(&path)?;
-            let text = std::fs::read_to_string(&path).map_err(|source| Error::ReadScenario {
-                path: path.clone(),
-                source,
-            })?;
-            let out =
-                out.unwrap_or_else(|| PathBuf::from("output").join(format!("{}-sweep", sc.name)));
-            let total = vary.iter().map(|v| v.values.len()).product::<usize>();
-            let variants = (0..total)
-                .filter(|i| shard.is_none_or(|s| i % s.count == s.index - 1))
-                .count();
-            let progress = Progress::new(variants as u64, quiet);
-            let bar = progress.0.clone();
-            if let Some(b) = &bar {
-                b.set_message("variants");
-            }
-            let done = std::sync::atomic::AtomicU64::new(0);
-            let on_variant = move || {
-                let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                if let Some(b) = &bar {
-                    b.set_position(n);
-                }
-            };
-            let options = app::SweepOptions { shard, runs };
-            let result = app::sweep(&text, &path, &vary, options, &out, &on_variant);
-            progress.finish();
-            let result = result?;
-            if !quiet {
-                println!(
-                    "{}: {} variant(s), {} failed -> {}",
-                    path.display(),
-                    result.variants,
-                    result.failed,
-                    result.csv.display()
-                );
-            }
-            Ok(())
-        }
+        } => sweep(
+            &scenario,
+            &vary,
+            out,
+            app::SweepOptions { shard, runs },
+            quiet,
+        ),
         Command::Check { scenario: path } => {
             let sc = scenario::load(&path)?;
             println!("{}: valid ({})", path.display(), sc.name);
             Ok(())
         }
-        Command::Materials { name, json } => {
-            let list: Vec<_> = material::presets()
-                .into_iter()
-                .filter(|p| {
-                    name.as_deref()
-                        .is_none_or(|n| material::preset(n).is_some_and(|q| q.name == p.name))
-                })
-                .collect();
-            if list.is_empty() {
-                return Err(Error::InvalidScenario {
-                    path: "<command line>".into(),
-                    issues: vec![fretsim::error::Issue::new(
-                        "NAME",
-                        format!("\"{}\" is not a preset", name.unwrap_or_default()),
-                    )],
-                });
-            }
-            let rows: Vec<_> = list
-                .iter()
-                .map(|p| {
-                    serde_json::json!({
-                        "name": p.name, "source": p.source, "material": p.material,
-                        "derived": app::derived(&fretsim::contact::ContactModel::new(p.material, 1.0, 0.0, fretsim::contact::Electrode::None), 1.0),
-                    })
-                })
-                .collect();
-            if json {
-                println!(
-                    "{}",
-                    serde_json::to_string_pretty(&rows).expect("serialisable")
+        Command::Materials { name, json } => materials(name, json),
+    }
+}
+
+/// `fretsim run`: the output folder is claimed before the solve, so that a folder that may
+/// not be written is refused before any time is spent.
+fn run(path: Option<PathBuf>, out: Option<PathBuf>, quiet: bool) -> Result<(), Error> {
+    let sc = match &path {
+        Some(p) => scenario::load(p)?,
+        None => scenario::default_scenario(),
+    };
+    let out = out.unwrap_or_else(|| PathBuf::from("output").join(&sc.name));
+    let folder = output::RunFolder::claim(&out, &output::Protected::new(path.as_deref()))?;
+    let total = sc.history.as_ref().map_or(0, |h| h.steps().len() as u64);
+    let mut progress = Progress::new(total, quiet);
+    let result = app::run_with(&sc, folder, &mut progress);
+    progress.finish();
+    let result = match result {
+        Ok(result) => result,
+        Err(e) => {
+            if matches!(e, Error::Solve { .. }) {
+                eprintln!(
+                    "fretsim: what was solved and failure.json are in {}",
+                    out.display()
                 );
-            } else {
-                for p in &list {
-                    println!("{:<10} {}", p.name, p.source);
-                    println!("           {:?}", p.material);
-                }
             }
-            Ok(())
+            return Err(e);
+        }
+    };
+    let n = &result.summary.normal_loading;
+    println!(
+        "{}: a = {:.6e} m, b/a = {:.6}, C = {:.6e} 1/m, p0 = {:.6e} Pa -> {}",
+        sc.name,
+        n.half_width,
+        n.stick_ratio,
+        n.strain_slope,
+        n.peak_pressure,
+        result.out_dir.display()
+    );
+    for w in &result.summary.warnings {
+        eprintln!("fretsim: warning: {w}");
+    }
+    Ok(())
+}
+
+/// `fretsim sweep`: exits 1 when any variant failed.
+fn sweep(
+    path: &Path,
+    vary: &[app::Vary],
+    out: Option<PathBuf>,
+    options: app::SweepOptions,
+    quiet: bool,
+) -> Result<(), Error> {
+    let sc = scenario::load(path)?;
+    let text = std::fs::read_to_string(path).map_err(|source| Error::ReadScenario {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let out = out.unwrap_or_else(|| PathBuf::from("output").join(format!("{}-sweep", sc.name)));
+    let total = vary.iter().map(|v| v.values.len()).product::<usize>();
+    let variants = (0..total)
+        .filter(|i| options.shard.is_none_or(|s| i % s.count == s.index - 1))
+        .count();
+    let progress = Progress::new(variants as u64, quiet);
+    let bar = progress.0.clone();
+    if let Some(b) = &bar {
+        b.set_message("variants");
+    }
+    let done = std::sync::atomic::AtomicU64::new(0);
+    let on_variant = move || {
+        let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        if let Some(b) = &bar {
+            b.set_position(n);
+        }
+    };
+    let protected = output::Protected::new(Some(path));
+    let result = app::sweep(&text, path, vary, options, &out, &protected, &on_variant);
+    progress.finish();
+    let result = result?;
+    println!(
+        "{}: {} variant(s), {} failed -> {}",
+        path.display(),
+        result.variants,
+        result.failed,
+        result.csv.display()
+    );
+    result.check().map(|_| ())
+}
+
+/// `fretsim materials`: a table with units, or JSON with `--json`.
+fn materials(name: Option<String>, json: bool) -> Result<(), Error> {
+    let list: Vec<_> = material::presets()
+        .into_iter()
+        .filter(|p| {
+            name.as_deref()
+                .is_none_or(|n| material::preset(n).is_some_and(|q| q.name == p.name))
+        })
+        .collect();
+    if list.is_empty() {
+        let names: Vec<_> = material::presets().iter().map(|p| p.name).collect();
+        return Err(Error::InvalidScenario {
+            path: "<command line>".into(),
+            issues: vec![fretsim::error::Issue::new(
+                "NAME",
+                format!(
+                    "\"{}\" is not a preset; it must be one of {}",
+                    name.unwrap_or_default(),
+                    names.join(", ")
+                ),
+            )],
+        });
+    }
+    if json {
+        let rows: Vec<_> = list
+            .iter()
+            .map(|p| {
+                let model = fretsim::contact::ContactModel::new(
+                    p.material,
+                    1.0,
+                    0.0,
+                    fretsim::contact::Electrode::None,
+                );
+                serde_json::json!({
+                    "name": p.name, "source": p.source, "material": p.material,
+                    "derived": app::derived(&model, 1.0),
+                })
+            })
+            .collect();
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&rows).expect("serialisable")
+        );
+        return Ok(());
+    }
+    print!("{}", materials_table(&list));
+    Ok(())
+}
+
+/// The presets as text tables with units: the piezoelectric constants, the elastic ones, and
+/// the sources.
+fn materials_table(list: &[material::Preset]) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    let piezo: Vec<_> = list
+        .iter()
+        .filter_map(|p| match p.material {
+            material::Material::Piezoelectric(c) => Some((p.name, c)),
+            material::Material::Elastic(_) => None,
+        })
+        .collect();
+    if !piezo.is_empty() {
+        out.push_str("piezoelectric (poled along z)\n");
+        let _ = writeln!(
+            out,
+            "{:<10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>9}",
+            "name", "c11", "c13", "c33", "c44", "e31", "e33", "e15", "eps11", "eps33"
+        );
+        let _ = writeln!(
+            out,
+            "{:<10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>9}",
+            "", "GPa", "GPa", "GPa", "GPa", "C/m²", "C/m²", "C/m²", "nF/m", "nF/m"
+        );
+        for (name, c) in &piezo {
+            let _ = writeln!(
+                out,
+                "{name:<10} {:>8.2} {:>8.2} {:>8.2} {:>8.2} {:>8.3} {:>8.3} {:>8.3} {:>9.4} {:>9.4}",
+                c.c11 / 1e9,
+                c.c13 / 1e9,
+                c.c33 / 1e9,
+                c.c44 / 1e9,
+                c.e31,
+                c.e33,
+                c.e15,
+                c.eps11 / 1e-9,
+                c.eps33 / 1e-9
+            );
         }
     }
+    let elastic: Vec<_> = list
+        .iter()
+        .filter_map(|p| match p.material {
+            material::Material::Elastic(c) => Some((p.name, c)),
+            material::Material::Piezoelectric(_) => None,
+        })
+        .collect();
+    if !elastic.is_empty() {
+        if !out.is_empty() {
+            out.push('\n');
+        }
+        out.push_str("isotropic elastic\n");
+        let _ = writeln!(
+            out,
+            "{:<10} {:>8} {:>8} {:>8}\n{:<10} {:>8} {:>8} {:>8}",
+            "name", "E", "mu", "nu", "", "GPa", "GPa", "-"
+        );
+        for (name, c) in &elastic {
+            let _ = writeln!(
+                out,
+                "{name:<10} {:>8.2} {:>8.2} {:>8.3}",
+                c.youngs_modulus() / 1e9,
+                c.shear_modulus / 1e9,
+                c.poisson_ratio
+            );
+        }
+    }
+    out.push_str("\nsources\n");
+    for p in list {
+        let _ = writeln!(out, "{:<10} {}", p.name, p.source);
+    }
+    out
 }
