@@ -91,6 +91,17 @@ impl Regime {
     }
 }
 
+impl std::fmt::Display for Regime {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Regime::NormalLoading => "normal loading",
+            Regime::Stick => "stick",
+            Regime::ForwardSlip => "forward slip",
+            Regime::ReverseSlip => "reverse slip",
+        })
+    }
+}
+
 /// The regime of a step with load increment `dq` (pure; `tol` absorbs round-off in ΔQ).
 pub fn next_regime(dq: f64, tol: f64) -> Regime {
     if dq > tol {
@@ -284,7 +295,7 @@ impl std::fmt::Display for StepFailure {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "step {} (t = {} s, Q = {} N/m, {:?})",
+            "step {} (t = {} s, Q = {} N/m, {})",
             self.step, self.t, self.q, self.regime
         )
     }
