@@ -446,9 +446,9 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 /// `Σ a_i b_i` with four vector accumulators (sixteen lanes with AVX2, chosen at run time by
 /// `pulp`), fused multiply–adds where the processor has them. Four scalar partial sums were
-/// four chains of dependent additions, latency-bound: the products with the iteration's
-/// matrices took a quarter of a tangential step at M = 128 (`docs/performance.md`,
-/// seventeenth session). The accumulators are summed pairwise at the end, then the lanes,
+/// four chains of dependent additions, latency-bound, and the products with the iteration's
+/// matrices are a large part of a tangential step. The accumulators are summed pairwise at
+/// the end, then the lanes,
 /// then the products left over from the lanes. The round-off therefore depends on the
 /// processor's lane width and on FMA; [`RowMatrix::apply`] gives each row's [`dot`] to the
 /// bit.

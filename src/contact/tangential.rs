@@ -179,7 +179,6 @@ pub struct SlipOptions {
     /// (with the trial iterates near the tolerance solved fully, module docs). Two solution
     /// paths to one state (mirror symmetry, Masing returns, halved load steps, the solver's
     /// options) agree to a few times the tolerance, and the tests bound them by ten times it.
-    /// The tolerance was 1e−13 until the twenty-fourth session.
     pub tolerance: f64,
     /// Maximum Newton iterations.
     pub max_iterations: usize,
@@ -2067,12 +2066,11 @@ fn solve_geometry(
     let mut evaluations = 1;
     let mut jac = hint;
     // Within a phase the coarse grid's Jacobian at the first iterate replaces the carried one
-    // (`coarse_jacobian`). Its evaluations are not counted: they are the coarse grid's.
-    // Measured, the forward step at 0.35 ηP of the default history: 8 → 6 residual
-    // evaluations at M = 128, the residual 3.5e−4 → 6.8e−7 in the first iteration instead of
-    // 1.7e−5. At a phase start the fine one is kept: tried there with a coarse grid at
-    // M = 64, the coarse one changed which admissible state three runs of the regression
-    // batch reached (`docs/performance.md`, thirteenth session).
+    // (`coarse_jacobian`). Its evaluations are not counted: they are the coarse grid's. It
+    // saves residual evaluations because within a phase the geometry changes little, so the
+    // coarse Jacobian at the current iterate is closer than the carried one. At a phase start
+    // the fine one is kept: there a coarse Jacobian can steer the iteration to another
+    // admissible state.
     if options.coarse_jacobian && method.within_phase() {
         jac = coarse_jacobian(problem, &g, &state).or(jac);
     }
@@ -2275,14 +2273,9 @@ fn secant_update(
 /// spoils the earlier secant conditions. Quasi-Newton steps within a phase are nearly
 /// parallel (mostly along the stick end that moves), so the update restarts, as Broyden's,
 /// when a step has less than a tenth of its length outside the earlier directions (or all
-/// four are taken; over the regression batch, a restart below 0.01 / 0.03 / 0.1 / 0.3 / 0.5
-/// of the length took 8155 / 8077 / 8073 / 8384 / 8645 evaluations).
-///
-/// Measured over the 17-run regression batch: residual evaluations 8859 → 8073, the states
-/// the same to the tolerance except at one step with two converged states 4.9e−5 a apart
-/// (`docs/performance.md`, sixteenth session); the default run at M = 64 645 → 577; a step
-/// of a PZT-4 variable-amplitude history at M = 128 that stalled at 2.8e−8 after 62
-/// evaluations converges in 8.
+/// four are taken; a tenth took the fewest evaluations over the regression runs). Against
+/// Broyden's update it saves residual evaluations and lets steps converge that would
+/// otherwise stall near the tolerance.
 #[derive(Debug, Default)]
 struct SecantDirections(Vec<[f64; 4]>);
 
