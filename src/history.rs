@@ -712,8 +712,7 @@ const HISTORY_POINTS: usize = 3;
 ///
 /// The geometry is smooth in Q within a phase, so the quadratic predictor starts the step
 /// closer to its solution than the linear one of the stick ends alone with the previous
-/// (a, c) (measured on the default run: 1272 → 1233 residual evaluations, first residual of
-/// the 0.30 → 0.35 ηP step at M = 128 5.5e−3 → 1.6e−3).
+/// (a, c), which saves residual evaluations.
 fn predict(history: &[[f64; 5]], q: f64) -> Option<[f64; 4]> {
     let last = history.last()?;
     // Points with distinct loads only (a repeated load would make the polynomial singular).
@@ -814,9 +813,8 @@ pub fn solve_step(
     // After a step with mixed slip signs (the first steps after a reversal, one edge still
     // slipping the old way) the previous stick ends do not continue the standard state: its
     // edge zone closes and that stick end jumps. The continuation then converges to a state
-    // that fails the stick check (default run: about 20 evaluations at each such step), so
-    // the Mindlin–Deresiewicz guess goes first (default run: 1439 → 1330 residual evaluations
-    // in all, the same states).
+    // that fails the stick check (about 20 wasted evaluations at each such step), so the
+    // Mindlin–Deresiewicz guess goes first; the states are the same either way.
     let after_mixed = driver.warm.is_some_and(|w| w.signs != (sign, sign));
     let guesses = if after_mixed {
         [md_guess, guess]
@@ -825,11 +823,10 @@ pub fn solve_step(
     };
     // The contact's half-width and centre to start from: extrapolated within a phase. At a
     // phase start the centre is moved by dc/dQ of the previous phase's first step times ΔQ,
-    // and the half-width, which changes little, is kept. (Default history: the first step of
-    // each reversal moves the centre by ∓2.6e−3 a, 1.25 times the first loading step's
-    // 2.1e−3 a; started from the old centre, the mixed-sign attempt of a reversal step spent
-    // about ten quasi-Newton iterations getting there. Default run: 1330 → 1168 residual
-    // evaluations in all, the same states.)
+    // and the half-width, which changes little, is kept. (The first step of a reversal moves
+    // the centre by about as much as the first loading step did; started from the old centre,
+    // the mixed-sign attempt of a reversal step spends about ten quasi-Newton iterations
+    // getting there. The states are the same either way.)
     let contact = if new_phase {
         driver.first_centre_slope.map(|slope| (a, c + slope * dq))
     } else {
