@@ -2015,7 +2015,7 @@ pub struct GradedTable {
 }
 
 /// The most nodes a piece of the contact integrals' rule takes (δ, δn, the arcsine moment, the
-/// shape force of mixed states; [`contact_piece_nodes`] gives short pieces fewer):
+/// shape force of mixed states; `contact_piece_nodes` gives short pieces fewer):
 /// `max(32, M/2)`, since a piece holds a share of the M-term series and the stick zone, one
 /// long piece, holds q̃'s whole series. Measured on the default history, M = 64 … 512, against
 /// four times the nodes: δ within 9e−11 of its range (over the 22-run regression batch 1.5e−6,
@@ -2088,7 +2088,7 @@ pub fn slip_check_rule_nodes(m: usize) -> usize {
 /// by a `nodes(x0, x1)`-point sine-graded Gauss–Legendre rule (nodes clustered like Chebyshev
 /// points at both ends, which absorbs square-root and logarithmic behaviour there: every point
 /// where f is not smooth must be among `points`); a piece whose two ends the balancing made
-/// by the plain rule of [`smooth_piece_nodes`] (as in [`graded_cumulative`]). Measured over
+/// by the plain rule of `smooth_piece_nodes` (as in [`graded_cumulative`]). Measured over
 /// the regression batch against eight times the nodes on every piece: δ unchanged to two
 /// digits in every run (1.5e−6 of its range at worst, the insulating Figure-3 histories at
 /// M = 64; 9.6e−9 at M = 128); test `the_contact_rule_gives_the_displacements_to_a_small_error`.
@@ -2413,7 +2413,7 @@ impl ContactModel {
 }
 
 impl ContactState {
-    /// `∫ f dt` over the contact by the contact integrals' rule ([`contact_piece_nodes`] on
+    /// `∫ f dt` over the contact by the contact integrals' rule (`contact_piece_nodes` on
     /// the pieces of [`graded_nodes`]), split at the traction's breakpoints
     /// and at `split` (if inside). With the centre kink of a normal-loading zone among the
     /// breakpoints (it was missing before), the arcsine moment's φ0 over the default history
