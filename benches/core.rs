@@ -131,10 +131,9 @@ fn bench_state(
 }
 
 /// The default history's first loading up to 0.30 ηP (steps of 0.05 ηP): the state from which
-/// the forward-step benches take the default run's step to 0.35 ηP. (Until the twenty-fourth
-/// session the lead-in took steps of 0.1 ηP, which the default run never takes; from it the
-/// quadratic predictor starts the half-as-long step 1.6e−3 from its solution instead of
-/// 3.5e−4, one residual evaluation more: `docs/performance.md`.)
+/// the forward-step benches take the default run's step to 0.35 ηP. The lead-in takes the
+/// default run's own steps, so that the quadratic predictor starts the timed step as it does in
+/// a run.
 fn lead_in() -> Vec<f64> {
     default_loads(0)[..6].to_vec()
 }

@@ -12,7 +12,7 @@
 //! per sample), which bursts of host slowness in a few samples pull up; the median over the
 //! samples (`estimates.json`, `median.point_estimate`) is what the performance targets are
 //! stated in. `--best` gives the fastest sample's time per iteration (`sample.json`), the
-//! floor that the interleaved timing loops of `docs/performance.md` also read. Results are read
+//! floor least disturbed by a busy host. Results are read
 //! from `target/criterion` (or `$CARGO_TARGET_DIR/criterion`, or the folder given as the last
 //! argument); nothing is written.
 

@@ -18,7 +18,7 @@ use crate::scenario::{RawScenario, Scenario};
 pub struct Derived {
     /// Surface compliance coefficients (fretsim's convention).
     pub compliance: SurfaceCompliance,
-    /// The same in the seed paper's convention (Appendix A.2).
+    /// The same in the paper's convention (Appendix A.2).
     pub paper_coefficients: PaperCoefficients,
     /// Δ1…Δ4 (Section 5).
     pub field_coefficients: SurfaceFieldCoefficients,

@@ -29,7 +29,7 @@ pub enum Command {
     },
     /// Sweep over scenario fields: one CSV row per variant, variants solved in parallel. By
     /// default each variant is the normal-loading solve alone (e.g. b/a and C against η, the
-    /// seed paper's Figures 8–9); with `--runs` each variant's whole scenario is run into
+    /// paper's Figures 8–9); with `--runs` each variant's whole scenario is run into
     /// `variant_NNNN/` and the fields of all variants are plotted together (Figures 6–7, 10–19).
     Sweep {
         /// Scenario file (JSON).

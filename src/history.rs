@@ -41,7 +41,7 @@
 //! its steps is started from that phase's step at the same load ([`Recalled`]). In a steady
 //! cycle that step solves the new one to the tolerance in one residual evaluation. Otherwise
 //! its residual exceeds the recall limit, and the step is solved as above
-//! (`SlipOptions::recall`; measured in `docs/performance.md`, ninth session).
+//! (`SlipOptions::recall`).
 //!
 //! A step's checks, φ0 and increments are functions of its two states (and the anchor, for
 //! δ). When a step begins from a state whose geometry and slip signs are to the bit those of
@@ -49,7 +49,7 @@
 //! evaluation solved it), its two states are the recalled step's to the solver's tolerance:
 //! it takes that step's checks and φ0 ([`Recalled::admissibility`]) and, when δ is followed
 //! at the same anchor, its increments ([`SolvedStep::known_increments`]) instead of
-//! evaluating them (measured: within 3.9e−14 of evaluating them, test
+//! evaluating them (test
 //! `repeated_steps_take_the_checks_and_increments_they_would_compute`). In a steady cycle
 //! every step does: the step is one residual evaluation.
 
@@ -723,8 +723,7 @@ const HISTORY_POINTS: usize = 3;
 ///
 /// The geometry is smooth in Q within a phase, so the quadratic predictor starts the step
 /// closer to its solution than the linear one of the stick ends alone with the previous
-/// (a, c) (measured on the default run: 1272 → 1233 residual evaluations, first residual of
-/// the 0.30 → 0.35 ηP step at M = 128 5.5e−3 → 1.6e−3).
+/// (a, c), which saves residual evaluations.
 fn predict(history: &[[f64; 5]], q: f64) -> Option<[f64; 4]> {
     let last = history.last()?;
     // Points with distinct loads only (a repeated load would make the polynomial singular).
@@ -825,9 +824,8 @@ pub fn solve_step(
     // After a step with mixed slip signs (the first steps after a reversal, one edge still
     // slipping the old way) the previous stick ends do not continue the standard state: its
     // edge zone closes and that stick end jumps. The continuation then converges to a state
-    // that fails the stick check (default run: about 20 evaluations at each such step), so
-    // the Mindlin–Deresiewicz guess goes first (default run: 1439 → 1330 residual evaluations
-    // in all, the same states).
+    // that fails the stick check (about 20 wasted evaluations at each such step), so the
+    // Mindlin–Deresiewicz guess goes first; the states are the same either way.
     let after_mixed = driver.warm.is_some_and(|w| w.signs != (sign, sign));
     let guesses = if after_mixed {
         [md_guess, guess]
@@ -836,11 +834,10 @@ pub fn solve_step(
     };
     // The contact's half-width and centre to start from: extrapolated within a phase. At a
     // phase start the centre is moved by dc/dQ of the previous phase's first step times ΔQ,
-    // and the half-width, which changes little, is kept. (Default history: the first step of
-    // each reversal moves the centre by ∓2.6e−3 a, 1.25 times the first loading step's
-    // 2.1e−3 a; started from the old centre, the mixed-sign attempt of a reversal step spent
-    // about ten quasi-Newton iterations getting there. Default run: 1330 → 1168 residual
-    // evaluations in all, the same states.)
+    // and the half-width, which changes little, is kept. (The first step of a reversal moves
+    // the centre by about as much as the first loading step did; started from the old centre,
+    // the mixed-sign attempt of a reversal step spends about ten quasi-Newton iterations
+    // getting there. The states are the same either way.)
     let contact = if new_phase {
         driver.first_centre_slope.map(|slope| (a, c + slope * dq))
     } else {

@@ -2,8 +2,11 @@
 //!
 //! Fretting contact of a rigid cylindrical punch (radius R) on a transversely isotropic
 //! piezoelectric half-plane (poled normal to the surface) or an isotropic elastic half-plane,
-//! in plane strain, after the seed paper (fretting contact of a piezoelectric half-plane under a
-//! rigid conducting cylindrical punch; equation numbers below are the paper's).
+//! in plane strain, after the paper (equation numbers below are the paper's):
+//!
+//! J. Su, L.-L. Ke and Y.-S. Wang, "Two-dimensional fretting contact of piezoelectric materials
+//! under a rigid conducting cylindrical punch", *Journal of Mechanics of Materials and
+//! Structures* 11(5), 535–558 (2016), doi:10.2140/jomms.2016.11.535.
 //!
 //! ## The model
 //! The surface response of the half-plane to a pressure p, shear traction q and surface charge g

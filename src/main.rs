@@ -9,13 +9,10 @@ use fretsim::cli::{Cli, Command};
 use fretsim::error::Error;
 use fretsim::{app, material, output, scenario};
 
-/// mimalloc instead of the system allocator: the bench's forward step at M = 128 makes about
-/// 2700 allocations (2.2 MB in all: the per-evaluation point lists, maps and batches), and
-/// with glibc's allocator malloc and free took about 5 % of it. Measured on that step
-/// (interleaved timing loops, best of 400, five rounds): 1.50–1.52 → 1.42–1.44 ms, its state
-/// 1.15–1.16 → 1.08–1.10 ms. Built without transparent huge pages (the crate's `no_thp`
-/// feature): with them the default run's peak memory is 24–25 MB instead of about 10 MB. The
-/// library itself sets no allocator; the dependency is the default feature `mimalloc`.
+/// mimalloc instead of the system allocator: the solver makes many small allocations per step
+/// (the per-evaluation point lists, maps and batches). Built without transparent huge pages
+/// (the crate's `no_thp` feature) to keep the peak memory small. The library itself sets no
+/// allocator; the dependency is the default feature `mimalloc`.
 #[cfg(feature = "mimalloc")]
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;

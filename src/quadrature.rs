@@ -129,11 +129,10 @@ impl RowMatrix {
 ///
 /// Stored by columns, the recurrence `v_{n+1} = 2τ_i v_n − v_{n−1}` runs across the points
 /// in SIMD lanes and each column is written in one sweep; stored by rows, the rows were
-/// filled four at a time, a chain of dependent operations per row (measured, 129 rows of 128
-/// terms: 2.8 µs by columns against 8.2 µs by rows). The product `y = A x` is a sum of
-/// columns, `y += x_n A[:, n]`, the rows in blocks of SIMD accumulators (1.6 µs against
-/// 1.5 µs for the rows' dot products). Rows are padded to whole SIMD vectors of four with
-/// zeros.
+/// filled four at a time, a chain of dependent operations per row, about three times slower.
+/// The product `y = A x` is a sum of columns, `y += x_n A[:, n]`, the rows in blocks of SIMD
+/// accumulators, as fast as the rows' dot products. Rows are padded to whole SIMD vectors of
+/// four with zeros.
 #[derive(Debug, Clone, Default)]
 pub struct ColumnMatrix {
     rows: usize,
@@ -446,9 +445,9 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 /// `Σ a_i b_i` with four vector accumulators (sixteen lanes with AVX2, chosen at run time by
 /// `pulp`), fused multiply–adds where the processor has them. Four scalar partial sums were
-/// four chains of dependent additions, latency-bound: the products with the iteration's
-/// matrices took a quarter of a tangential step at M = 128 (`docs/performance.md`,
-/// seventeenth session). The accumulators are summed pairwise at the end, then the lanes,
+/// four chains of dependent additions, latency-bound, and the products with the iteration's
+/// matrices are a large part of a tangential step. The accumulators are summed pairwise at
+/// the end, then the lanes,
 /// then the products left over from the lanes. The round-off therefore depends on the
 /// processor's lane width and on FMA; [`RowMatrix::apply`] gives each row's [`dot`] to the
 /// bit.
@@ -779,18 +778,16 @@ fn recurrence_row(tau: f64, [mut prev, mut cur, scale]: [f64; 3], row: &mut [f64
 /// sums run as independent chains `b_j = (c − b_{j+2}) + α b_{j+1}`, which the processor
 /// overlaps (the one-step recurrence is a chain of dependent multiply–adds, as long as the
 /// series). The subtraction does not wait for `b_{j+1}`, so a link of the chain is one
-/// multiplication and one addition (written `c + α b_{j+1} − b_{j+2}`, it was a
-/// multiplication and two additions: the forward step at M = 128 took 7 % longer, 1.29–1.31
-/// against 1.20–1.22 ms, and 9 % with its increments). Returns `(b_0, b_1)` of the even chain
+/// multiplication and one addition (written `c + α b_{j+1} − b_{j+2}`, it would be a
+/// multiplication and two additions on the chain). Returns `(b_0, b_1)` of the even chain
 /// and of the odd chain at each of the `L`
 /// points; the points' chains run interleaved (four points give eight independent chains),
 /// each with the same operations in the same order, so a point's sums do not depend on the
 /// others. The chains are compiled for the processor's widest SIMD lanes, chosen at run time
 /// by `pulp` (AVX2 puts four points' chains in one register, where SSE2 needs two): the same
 /// multiplications and additions, no fused ones, so the sums are [`clenshaw_pair`]'s to the bit
-/// on every processor. Measured at M = 128 (forward step, interleaved loops): these sums took
-/// 14 % of the step, the step about 10 % less with the wider lanes; the 17-run batch's
-/// outputs are the same to the bit.
+/// on every processor. These sums are a sizeable part of a tangential step, which is why they
+/// get the wider lanes.
 fn clenshaw_pairs<const L: usize>(c: &[f64], x: [f64; L]) -> [([f64; 2], [f64; 2]); L] {
     struct Pairs<'a, const L: usize>(&'a [f64], [f64; L]);
     impl<const L: usize> pulp::WithSimd for Pairs<'_, L> {
@@ -822,9 +819,8 @@ fn clenshaw_pairs_scalar<const L: usize>(c: &[f64], x: [f64; L]) -> [([f64; 2], 
 }
 
 /// [`clenshaw_pairs`] at one point, written out: the one-point sums are the hot path of the
-/// chain's values one point at a time, and the one-lane instance of the generic form made the
-/// default history 5–10 % slower at M = 64 and 128 (interleaved runs); the operations are the
-/// same, so the sums are bit-identical.
+/// chain's values one point at a time, where the one-lane instance of the generic form is
+/// slower; the operations are the same, so the sums are bit-identical.
 fn clenshaw_pair(c: &[f64], x: f64) -> ([f64; 2], [f64; 2]) {
     let alpha = 4.0 * x * x - 2.0;
     let pairs = c.chunks_exact(2);

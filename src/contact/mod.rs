@@ -356,9 +356,8 @@ impl ChainTable {
 
     /// [`Self::at`] at each of `xs` into `out`, `fallback(x)` outside the table (bit-identical;
     /// eight, else four, consecutive points on one piece share one sum, their recurrences
-    /// interleaved: eight instead of four made the bench's forward step at M = 128 2.4 %
-    /// faster, best of 150 in eight rounds 0.882–0.887 → 0.861–0.865 ms; each point's piece is
-    /// found once).
+    /// interleaved, because the recurrences are latency-bound; each point's piece is found
+    /// once).
     fn values_into(&self, xs: &[f64], fallback: impl Fn(f64) -> f64, out: &mut Vec<f64>) {
         let pieces: Vec<Option<usize>> = xs.iter().map(|&x| self.piece(x)).collect();
         let run = |k: usize, len: usize| {
@@ -395,9 +394,8 @@ impl ChainTable {
 }
 
 /// The Chebyshev points `v_k = cos θ_k`, `θ_k = (2k+1)π/(2N)`, of a [`ChainTable`]'s pieces
-/// and the fast transform of its cosine sums, built once per N (the N² cosines of the sums as
-/// a matrix took 0.5 ms for a base zone's table at M = 128 when they were computed at every
-/// table, and the product 4 µs per piece of 128 points, the transform 0.2 µs).
+/// and the fast transform of its cosine sums, built once per N: computing the N² cosines for
+/// every table would cost far more than the transform that uses them.
 struct ChebyshevPoints {
     v: Vec<f64>,
     transforms: crate::transforms::HalfAngleTransforms,
@@ -642,12 +640,9 @@ use group_quotient;
 /// The divisions bound these sums, so the nodes are taken in pairs over a common
 /// denominator (`group_quotient`; a skipped node as `n = 0, d = 1`): one division for two
 /// terms, with a rounding error of the same order as the two quotients' (the distances are at
-/// least `tiny`, so their products stay far above f64's smallest normal number). The forward
-/// step at M = 128 (best of 400, interleaved rounds): a division a term 1.008–1.014 ms, pairs
-/// 0.983–0.990 ms; the SIMD sums without the skipped nodes' masks where no node is near
-/// (`FadeSums`) 0.912–0.920 → 0.896–0.902 ms. Groups of four over one denominator were no
-/// faster (a separate measurement of the sums alone, 128 points and 384 nodes: 0.32 ns a term
-/// with a division each, 0.18 in pairs, 0.20 in fours, 0.33 in pairs with the masks).
+/// least `tiny`, so their products stay far above f64's smallest normal number). Where no
+/// node is near, the SIMD sums (`FadeSums`) run without the skipped nodes' masks. Pairs are
+/// the sweet spot: groups of four over one denominator save no further time.
 #[inline(always)]
 fn fade_sum(nodes: &[(f64, f64, f64)], x: f64, cx: f64, tiny: f64) -> f64 {
     let term = |&(t, wq, chi): &(f64, f64, f64)| {
@@ -737,7 +732,7 @@ impl Inherited {
     /// `FADE_TABLE_REUSE` of a ramp's length of this link's, and has its table. A step's
     /// evaluations near convergence move the ramps by far less (and the coarse grid's first
     /// evaluation, at the fine grid's first iterate, not at all), while the table's values,
-    /// sums of `M` terms at 384 points at M = 128, cost about 20 µs an evaluation.
+    /// sums of `M` terms at a few hundred points, are a noticeable part of an evaluation.
     /// The pieces then end up to that distance from the ramps' ends, where χ has a jump in its
     /// third derivative; the transform changes by about `2.4e−6 (δ/r)²` of its largest value
     /// (δ the distance, r the ramp's length; measured from δ/r = 9e−5 to 1e−3, test
@@ -1002,8 +997,8 @@ pub fn kink_density(u: f64) -> f64 {
     if u.abs() >= 1.0 || u.abs() < 1e-300 {
         return 0.0;
     }
-    // artanh √(1 − u²) = ln((1 + √(1 − u²))/|u|): one logarithm (two, of the numerator and of
-    // |u|, made the forward step at M = 128 1 % slower, 0.894–0.896 against 0.885–0.888 ms).
+    // artanh √(1 − u²) = ln((1 + √(1 − u²))/|u|): one logarithm of the quotient rather than
+    // two (of the numerator and of |u|), on a hot path.
     -2.0 * u / std::f64::consts::PI * ((1.0 + (1.0 - u * u).sqrt()) / u.abs()).ln()
 }
 
@@ -1035,10 +1030,8 @@ fn exterior_table_nodes(terms: usize) -> usize {
 /// Points on the exterior pieces that make a batch of [`StickZone::correction_cauchys_into`]
 /// tabulate the transform there. A step's slip check asks for about 300 at M = 128, its
 /// dissipation about 500, and the next step's as many again of the same zone as the old
-/// state; the tables cost `2 exterior_table_nodes(M)` direct sums (256 at M = 128). The
-/// forward step of the benches at M = 128: 1.84–1.85 against 1.94 ms with its increments, its
-/// state (whose check builds the tables and uses them once) 1.39–1.41 against 1.40–1.46 ms
-/// (best of 300 and 400, five interleaved rounds).
+/// state; the tables cost `2 exterior_table_nodes(M)` direct sums (256 at M = 128), so below
+/// this many points direct sums are cheaper and above it the table pays for itself.
 const EXTERIOR_TABLE_POINTS: usize = 128;
 
 /// The largest move of a fade ramp's points, relative to its length, over which an evaluation
@@ -1053,13 +1046,8 @@ const FADE_POINTS: f64 = 6.0;
 /// Points whose Chebyshev sums are interleaved in the batched evaluations of a zone's own part
 /// ([`StickZone::own_parts_into`]) and of the contact's series
 /// ([`ContactState::pressures_into`] and the like): the Clenshaw recurrences are
-/// latency-bound, and eight independent points instead of four made the first-loading step at
-/// M = 128 5 % faster for the zones (2.60–2.63 against 2.74–2.76 ms, best of 300 in four
-/// interleaved rounds; 16 points 2.59–2.62 ms) and 2.5 % more for the contact's series
-/// (2.55–2.57 ms), with the same bits. (Eight rows at a time in
-/// the row-major fill of the inner maps (since stored by columns,
-/// [`crate::quadrature::ColumnMatrix`]) instead of four was slower, 2.66
-/// against 2.62 ms.)
+/// latency-bound, so eight independent points keep more of them in flight than four (sixteen
+/// gain nothing more), with the same bits.
 const OWN_LANES: usize = 8;
 
 /// A zone's own part in one form (density or Cauchy transform): the series at
@@ -1414,17 +1402,12 @@ impl StickZone {
     /// least a tenth of the new zone. Below that, the ramp covers the whole overlap (from the
     /// new end to the remembered one), provided at least `FADE_POINTS` of the new zone's
     /// collocation points fall within it; otherwise the earlier zone is passed over and its
-    /// kink is left to the series. (Before the whole-overlap ramp, every overlap below a tenth
-    /// was passed over.)
+    /// kink is left to the series.
     ///
-    /// Measured on the insulating Figure-3 history at η = 0.2 against M = 256, whose steps
-    /// 57–60 have a remembered end 0.06–0.09 of the zone from the new one:
-    /// - worst stick end at M = 64: 1.4e−3 a → 3.2e−4 a;
-    /// - worst step dissipation at M = 64: 4.5e−2 → 2.3e−3;
-    /// - at M = 128: 9.7e−4 a and 3.1e−2 → 1.1e−4 a and 9.3e−4;
-    /// - the other steps of the history stay at 3.3e−4 a and 1.1e−2 (M = 64).
-    ///
-    /// None of 24 other histories is changed.
+    /// Why: where a remembered end lies within a tenth of the zone of the new one (the
+    /// insulating Figure-3 history at η = 0.2, steps 57–60), leaving its kink to the series
+    /// makes those steps' stick ends and dissipations several times less accurate than the
+    /// rest of the history; the ramp brings them back in line.
     pub fn inheritance_for(
         self: &std::sync::Arc<Self>,
         lo: f64,
@@ -2032,7 +2015,7 @@ pub struct GradedTable {
 }
 
 /// The most nodes a piece of the contact integrals' rule takes (δ, δn, the arcsine moment, the
-/// shape force of mixed states; [`contact_piece_nodes`] gives short pieces fewer):
+/// shape force of mixed states; `contact_piece_nodes` gives short pieces fewer):
 /// `max(32, M/2)`, since a piece holds a share of the M-term series and the stick zone, one
 /// long piece, holds q̃'s whole series. Measured on the default history, M = 64 … 512, against
 /// four times the nodes: δ within 9e−11 of its range (over the 22-run regression batch 1.5e−6,
@@ -2052,9 +2035,8 @@ pub fn field_rule_nodes(m: usize) -> usize {
 /// times): δ within 1.5e−8 of its range at M ≥ 96 (the whole rule: 4.3e−11), the geometry
 /// (through φ0's arcsine moment) within 2.4e−11 a and the dissipation within 4e−9 of the
 /// largest step dissipation, as with the whole rule (the stalled step 47 of the insulating
-/// Figure-3 history at η = 0.4 aside, which moves with any change of round-off). The forward
-/// step of the bench at M = 128 with its increments: 1.34–1.36 → 1.27–1.28 ms (best of 400,
-/// five interleaved rounds; its state alone within 1 %).
+/// Figure-3 history at η = 0.4 aside, which moves with any change of round-off), for fewer
+/// nodes on the pieces far from the contact ends.
 fn contact_piece_nodes(x0: f64, x1: f64, (c, a): (f64, f64), m: usize) -> usize {
     let most = field_rule_nodes(m);
     let theta = |x: f64| ((x - c) / a).clamp(-1.0, 1.0).acos();
@@ -2106,7 +2088,7 @@ pub fn slip_check_rule_nodes(m: usize) -> usize {
 /// by a `nodes(x0, x1)`-point sine-graded Gauss–Legendre rule (nodes clustered like Chebyshev
 /// points at both ends, which absorbs square-root and logarithmic behaviour there: every point
 /// where f is not smooth must be among `points`); a piece whose two ends the balancing made
-/// by the plain rule of [`smooth_piece_nodes`] (as in [`graded_cumulative`]). Measured over
+/// by the plain rule of `smooth_piece_nodes` (as in [`graded_cumulative`]). Measured over
 /// the regression batch against eight times the nodes on every piece: δ unchanged to two
 /// digits in every run (1.5e−6 of its range at worst, the insulating Figure-3 histories at
 /// M = 64; 9.6e−9 at M = 128); test `the_contact_rule_gives_the_displacements_to_a_small_error`.
@@ -2265,8 +2247,7 @@ const GRADED_NODES: usize = 96;
 /// M = 128 and 4e−7 a where a remembered stick end lies close to the new one; 32 nodes
 /// changed the dissipation of the insulating Figure-3 history by 7.6e−4. The stall of step 47
 /// of its η = 0.4 variant moves with any change of round-off and is left out of these figures.
-/// Against 96 nodes, the forward step at M = 128 takes about 8 % less (best of 400 in five
-/// interleaved rounds: 1.59–1.64 ms against 1.73–2.02 ms).
+/// 64 nodes are therefore the fewest that keep the errors below the discretisation's.
 const FADE_RULE_NODES: usize = 64;
 
 /// A sine-graded Gauss–Legendre rule on [−1, 1] (`u = sin(πv/2)`, see [`graded_rule`]) with
@@ -2432,7 +2413,7 @@ impl ContactModel {
 }
 
 impl ContactState {
-    /// `∫ f dt` over the contact by the contact integrals' rule ([`contact_piece_nodes`] on
+    /// `∫ f dt` over the contact by the contact integrals' rule (`contact_piece_nodes` on
     /// the pieces of [`graded_nodes`]), split at the traction's breakpoints
     /// and at `split` (if inside). With the centre kink of a normal-loading zone among the
     /// breakpoints (it was missing before), the arcsine moment's φ0 over the default history

@@ -110,9 +110,8 @@
 //! inherits one which already carries part of it adds only the difference,
 //! `RememberedRoot::carried_sign`).
 //!
-//! Measured (default history, against M = 512): stick ends 1e−3 a → 7.7e−5 a and the last
-//! cycle's friction work 1.1e−3 → 9e−5 at M = 64; at 0.3 ηP of the first loading the stick ends
-//! agree to 2.3e−5 a between M = 64 and 512.
+//! With the kinks in closed form the stick ends and the friction work converge about ten times
+//! faster in M (`docs/performance.md`, "Convergence in M").
 //!
 //! # States beyond the seed paper's form
 //! - Right after a reversal in a coupled contact the contact shifts, and one edge may keep its
@@ -179,7 +178,6 @@ pub struct SlipOptions {
     /// (with the trial iterates near the tolerance solved fully, module docs). Two solution
     /// paths to one state (mirror symmetry, Masing returns, halved load steps, the solver's
     /// options) agree to a few times the tolerance, and the tests bound them by ten times it.
-    /// The tolerance was 1e−13 until the twenty-fourth session.
     pub tolerance: f64,
     /// Maximum Newton iterations.
     pub max_iterations: usize,
@@ -229,7 +227,7 @@ pub struct SlipOptions {
     /// Within a phase, update the Jacobian by the projected secant update
     /// (`SecantDirections`) instead of Broyden's: each update keeps the Jacobian's action on
     /// the attempt's earlier step directions. The states are the same to the tolerance; the
-    /// steps take fewer residual evaluations (the default run, M = 64: 645 → 577).
+    /// steps take fewer residual evaluations.
     pub projected_updates: bool,
 }
 
@@ -340,9 +338,7 @@ struct StepProblem<'a> {
 /// of the chain and the remembered strain at the stick points (lo, hi), and S with the
 /// inherited traction at the sample points (a, c). A finite-difference Jacobian moves one
 /// unknown at a time, so two of its four evaluations find each part of its base point here
-/// and skip the chain's sums (measured on the bench's forward step at M = 128, interleaved
-/// timing loops, best of 400 in five rounds: 1.42–1.44 → 1.41–1.43 ms, its state 1.07–1.09
-/// → 1.07–1.08 ms; every output of the regression batch byte-identical, as it must be). An
+/// and skip the chain's sums (every output stays byte-identical, as it must). An
 /// entry is taken only for the same grid, bit-identical points, the same inherited link (the
 /// same `Arc`) and extras and the same slip signs (and stick ends, for a mixed state's S), so
 /// what it holds is what the evaluation would compute, bit for bit. It lives for one
@@ -685,12 +681,8 @@ impl StepProblem<'_> {
         // phase) the guess's own roots, which its inner iteration converged; otherwise q̃ of the
         // guess probed at this geometry's probe points. (Probed on the same chain, they were off
         // by the ends' move over the probe distance, 1e−2 of the half-width: the first pass
-        // changed them ten times more than the traction. Measured with the stored roots: inner
-        // passes −7 to −11 % over the default histories at M = 64 and 128, the insulating
-        // Figure-3 history at M = 128 and the PZT-4 variable-amplitude one; the forward step's
-        // state at M = 128 4 % faster (at M = 256 one evaluation more, by round-off); the
-        // regression batch 8661 → 8707 evaluations, every geometry within 2.4e−11 a but the
-        // stalled step 47 of the insulating Figure-3 history at η = 0.4, 7.7e−7 a away.)
+        // changed them ten times more than the traction, so the stored roots save inner
+        // passes.)
         if coupled {
             x.extend(guess_zone.map_or([0.0; 2], |z| {
                 if same_chain {
@@ -858,8 +850,8 @@ const INNER_TOLERANCE: f64 = 1e-14;
 /// Largest first residual with which a recalled step is continued ([`Recalled`]): where the
 /// step's problem is the recalled one's, the first residual is the recalled state's own, below
 /// the solver's tolerance but for round-off (measured over the 22 runs of
-/// `docs/performance.md`'s batch at the tolerance 1e−11: 458 recalled steps, median 1.1e−12,
-/// largest 1.14e−11; at 1e−13 the largest was 1.5e−13), while a problem that differs starts
+/// the regression runs at the tolerance 1e−11: median 1.1e−12, largest 1.14e−11), while a
+/// problem that differs starts
 /// at the size of a load step's change of the residuals (1e−4–1e−3). A larger one means the
 /// problem differs, and the step's own attempts decide among its sign patterns.
 const RECALL_RESIDUAL: f64 = 1e-9;
@@ -867,15 +859,9 @@ const RECALL_RESIDUAL: f64 = 1e-9;
 /// The inner tolerance of a trial iterate when the current residual norm is `residual`: an
 /// inexact Newton method, whose residuals need only be accurate to a small fraction (here
 /// 1e−3) of the residual being reduced; never looser than 1e−8 nor tighter than
-/// [`INNER_TOLERANCE`]. A step is accepted only on a residual evaluated at the full tolerance
-/// (measured, 0.30 → 0.35 ηP at M = 128: 71 → 51 passes of the inner iteration, the same
-/// number of residual evaluations). The first step after a reversal, whose failed attempts
-/// wander, reacts to the inner tolerance erratically: measured before the contact centre was
-/// predicted at phase starts (which made that step 2–5 times cheaper, 717 ms at M = 512),
-/// against full inner solves it took
-/// 30 / 91 / 315 ms instead of 34 / 97 / 350 ms at M = 64 / 128 / 256, but 3.5 s instead of
-/// 1.4 s at M = 512 (an upper clamp of 1e−10: 111 / 273 / 368 ms and 1.27 s; loose solves
-/// within a phase only: 38 / 98 / 351 ms and 1.41 s, the default run 0.60 s instead of 0.54 s).
+/// [`INNER_TOLERANCE`]. A step is accepted only on a residual evaluated at the full tolerance,
+/// so the loose trials save inner passes without changing the accepted states. The first step
+/// after a reversal, whose failed attempts wander, reacts to the inner tolerance erratically.
 fn inner_tolerance(residual: f64) -> f64 {
     (1e-3 * residual).clamp(INNER_TOLERANCE, LOOSEST_INNER_TOLERANCE)
 }
@@ -884,8 +870,8 @@ fn inner_tolerance(residual: f64) -> f64 {
 const LOOSEST_INNER_TOLERANCE: f64 = 1e-8;
 
 /// The inner tolerance of the finite-difference Jacobian's evaluations: its differences over
-/// steps of 1e−6 a change the residuals by about 1e−6, so 1e−11 leaves 1e−5 of the Jacobian
-/// (default run: inner passes 7707 → 7453, the states within 2.4e−13 a).
+/// steps of 1e−6 a change the residuals by about 1e−6, so 1e−11 leaves 1e−5 of the Jacobian,
+/// and a tighter tolerance would cost inner passes without changing the states.
 const JACOBIAN_INNER_TOLERANCE: f64 = 1e-11;
 
 /// The coefficients that scale the rows of [`InnerMaps`].
@@ -1080,9 +1066,8 @@ const END_PROBE: f64 = 0.01;
 /// of its distance, so that both probes read the stretch between the two roots (unless that
 /// puts them closer to the end than the series' first node: then d stays): in a steady
 /// cycle the extreme states' stick ends lie about 0.01a apart, and probes straddling the
-/// remembered one misread k, whose kinks the series then had to carry (measured, default
-/// history against M = 2048: the worst stick end at M = 64 2.1e−4 → 8.2e−5 a, at M = 128
-/// 1.15e−4 → 2.8e−5 a; `docs/performance.md`). Reading k from the series' end values `ψ(±1)`
+/// remembered one misread k, whose kinks the series then had to carry (`docs/performance.md`,
+/// "Convergence in M"). Reading k from the series' end values `ψ(±1)`
 /// instead (the exact limit of a polynomial) is ill-conditioned: the sum
 /// `Σ (±1)ⁿ (n + 1) β_n` weighs the coefficients' tail, and at M = 256 it moved by 1e−3 of
 /// itself between evaluations 1e−6 a apart, which stalled steps at residuals of 1e−7. The
@@ -1183,9 +1168,8 @@ impl StickSums {
 /// coefficients (each applied once per pass instead of a Clenshaw sum per point): at the stick
 /// points, the stick right-hand side from the pressure (`local p − η s y11 H'p`, over y11) and
 /// from the charge (`w13 w`, over y11), both from one matrix of `T_n` values
-/// ([`Self::stick_terms`]; with a matrix each for p, w and `H'p`, read at every pass, the
-/// forward step at M = 128 took 5 % longer, 0.990–0.999 against 0.941–0.945 ms, best of 400
-/// in three interleaved rounds); at the pressure and charge points inside the stick
+/// ([`Self::stick_terms`]; one matrix instead of one each for p, w and `H'p`: less memory
+/// to read at every pass); at the pressure and charge points inside the stick
 /// zone, the density of the stick correction (zero at the others). (The pressure's density at
 /// its own and the charge's collocation points does not depend on the geometry: it is a
 /// sine transform, [`Discretisation::bounded_at_collocation`].) For mixed slip signs,
@@ -2047,8 +2031,7 @@ fn solve_geometry(
     let solve_fully = |g: &Geometry, s: &ContactState| problem.evaluate(g, s, INNER_TOLERANCE);
     // The first residual of an attempt is a trial iterate's whose size is not known yet: it is
     // solved to the loosest inner tolerance (an accepted residual is solved again at the
-    // full tolerance anyway; default run: inner passes 8483 → 7707, the same evaluations,
-    // the states within 2.4e−13 a).
+    // full tolerance anyway, so this saves inner passes and leaves the states unchanged).
     let recalled = matches!(method, Method::Recall(_));
     let first_tolerance = if recalled {
         INNER_TOLERANCE
@@ -2067,12 +2050,11 @@ fn solve_geometry(
     let mut evaluations = 1;
     let mut jac = hint;
     // Within a phase the coarse grid's Jacobian at the first iterate replaces the carried one
-    // (`coarse_jacobian`). Its evaluations are not counted: they are the coarse grid's.
-    // Measured, the forward step at 0.35 ηP of the default history: 8 → 6 residual
-    // evaluations at M = 128, the residual 3.5e−4 → 6.8e−7 in the first iteration instead of
-    // 1.7e−5. At a phase start the fine one is kept: tried there with a coarse grid at
-    // M = 64, the coarse one changed which admissible state three runs of the regression
-    // batch reached (`docs/performance.md`, thirteenth session).
+    // (`coarse_jacobian`). Its evaluations are not counted: they are the coarse grid's. It
+    // saves residual evaluations because within a phase the geometry changes little, so the
+    // coarse Jacobian at the current iterate is closer than the carried one. At a phase start
+    // the fine one is kept: there a coarse Jacobian can steer the iteration to another
+    // admissible state.
     if options.coarse_jacobian && method.within_phase() {
         jac = coarse_jacobian(problem, &g, &state).or(jac);
     }
@@ -2183,9 +2165,8 @@ fn solve_geometry(
             };
             if problem.valid(&gn) {
                 // Near the tolerance the trial is solved fully, so that it can be accepted as
-                // it is (a loose one below the tolerance would be evaluated again): a
-                // forward step at M = 128 of the default run 5 → 4 fine evaluations, the
-                // regression batch 7713 instead of 8444 with loose trials throughout.
+                // it is (a loose one below the tolerance would be evaluated again, one fine
+                // evaluation more).
                 let inner = if near {
                     INNER_TOLERANCE
                 } else {
@@ -2275,14 +2256,9 @@ fn secant_update(
 /// spoils the earlier secant conditions. Quasi-Newton steps within a phase are nearly
 /// parallel (mostly along the stick end that moves), so the update restarts, as Broyden's,
 /// when a step has less than a tenth of its length outside the earlier directions (or all
-/// four are taken; over the regression batch, a restart below 0.01 / 0.03 / 0.1 / 0.3 / 0.5
-/// of the length took 8155 / 8077 / 8073 / 8384 / 8645 evaluations).
-///
-/// Measured over the 17-run regression batch: residual evaluations 8859 → 8073, the states
-/// the same to the tolerance except at one step with two converged states 4.9e−5 a apart
-/// (`docs/performance.md`, sixteenth session); the default run at M = 64 645 → 577; a step
-/// of a PZT-4 variable-amplitude history at M = 128 that stalled at 2.8e−8 after 62
-/// evaluations converges in 8.
+/// four are taken; a tenth took the fewest evaluations over the regression runs). Against
+/// Broyden's update it saves residual evaluations and lets steps converge that would
+/// otherwise stall near the tolerance.
 #[derive(Debug, Default)]
 struct SecantDirections(Vec<[f64; 4]>);
 

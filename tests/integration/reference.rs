@@ -171,8 +171,7 @@ fn solver_tolerance() -> f64 {
 
 /// Two runs of the same steps reached the same states to the solver's tolerance: the
 /// geometry and δ within ten times it (relative to a), the step dissipations within a hundred
-/// times it (relative to the largest; [`record_differences`]). These bounds were 1e−12 and
-/// 1e−11 at the tolerance 1e−13 of the twenty-third session and before.
+/// times it (relative to the largest; [`record_differences`]).
 fn assert_same_states(
     one: &[fretsim::history::StepRecord],
     other: &[fretsim::history::StepRecord],
@@ -985,15 +984,12 @@ fn cycle_verdicts() {
 /// right slip signs exchanged and negated, the same a and dissipation. Run on the paper's
 /// baseline through two reversals of a coupled contact (0 → ½ → −½ → ½ ηP in steps of
 /// 0.05 ηP), where a direction-dependent choice in the state machine (the order in which
-/// slip states are tried, the guesses) would break it. Measured at the solver tolerance 1e−11
-/// (twenty-fourth session): stick ends to 4.0e−12 a, e and a to 3.4e−13 a, δ to 1.4e−11 and
-/// the dissipation to 2.0e−11 of their largest values (at the tolerance 1e−13 of the twelfth
-/// session: 1.3e−13 a, 1.6e−14 a, 1.7e−13 and 9.7e−13, round-off). With the twenty-fifth
-/// session's Cauchy sums (the same sums, other round-off) the two runs' iterates land
-/// elsewhere below the tolerance: stick ends to 1.4e−11 a, e and a to 1.4e−12 a, δ to
-/// 1.5e−11, the dissipation to 1.5e−10. The dissipation of a step moves about ten times its
-/// stick ends (7.5 and 10.6 at the two tolerances: it integrates strain changes over slip zones
-/// a few hundredths of a wide), so its bound is ten times the geometry's, as in the other
+/// slip states are tried, the guesses) would break it. Measured at the solver tolerance 1e−11:
+/// stick ends to 1.4e−11 a, e and a to 1.4e−12 a, δ to 1.5e−11, the dissipation to 1.5e−10 of
+/// their largest values (the two runs' iterates differ in round-off and land at different
+/// points below the tolerance). The dissipation of a step moves about ten times its stick
+/// ends (it integrates strain changes over slip zones a few hundredths of a wide), so its
+/// bound is ten times the geometry's, as in the other
 /// tests that compare two paths to one state (`assert_same_states`). Bounds: the geometry ten
 /// times the solver's tolerance, δ 1e−10, the dissipation a hundred times the tolerance.
 #[test]
@@ -1179,13 +1175,11 @@ fn coupled_cycle_masing_return_and_step_refinement() {
 /// turning points and at every step, and the friction work of the last cycle, M = 64 against
 /// M = 128. The kinks of p and w at the stick ends (new and remembered) are what make them
 /// converge: measured 2.6e−5 a at the turning points, 1.8e−4 a at the worst step and 5.3e−5
-/// of the work (before the end probes kept clear of a remembered stick end just inside the new
-/// one, twelfth session: 3.0e−4 a at step 69, where it lies 0.016a inside, and 1.3e−4);
-/// without the kinks 8.0e−4 a and 1.1e−3 at the turning points. The bounds are about twice the
-/// measured differences. Two coarse resolutions agreeing is a guard against regressions, not
-/// a proof of convergence: before that change M = 64 and 128 agreed at the +½ ηP turning state
-/// to 7e−6 a while both were 1.2e−4 a from M = 2048 (`docs/performance.md`, "Every step
-/// against M = 2048").
+/// of the work; without the kinks 8.0e−4 a and 1.1e−3 at the turning points. The bounds are
+/// about twice the measured differences. Two coarse resolutions agreeing is a guard against
+/// regressions, not a proof of convergence: two resolutions can agree closely while both are
+/// off the converged state, which is why `docs/performance.md` compares every step against
+/// M = 2048.
 #[test]
 fn default_history_stick_ends_and_work_converge_in_m() {
     let lim = baseline(64).lim;
@@ -1496,10 +1490,9 @@ fn pipelined_history_matches_sequential_steps() {
 /// 0.05 ηP) through three ±½ ηP cycles, with and without recall. Forward phase 3 repeats
 /// forward phase 2 and reverse phase 3 repeats reverse phase 2 (reverse phase 1 began from
 /// the first loading's state and is not recalled). Measured: every recalled step takes one
-/// residual evaluation (the whole run 806 → 514 at the solver tolerance 1e−11; 933–943 →
-/// 581–585 at 1e−13 over the twentieth session's builds, which differ in round-off), and the
+/// residual evaluation (the whole run 514 evaluations against 806 without recall), and the
 /// records differ by at most 1.2e−12 a in the geometry and δ and 3.8e−13 of the largest step
-/// dissipation (at 1e−13: 5.0e−14 a and 5.4e−13; bounds [`assert_same_states`]). A recall
+/// dissipation (bounds [`assert_same_states`]). A recall
 /// from the wrong step fails the residual gate and is solved afresh (more evaluations).
 #[test]
 fn recalled_cycles_repeat_the_solved_ones() {
@@ -1524,16 +1517,13 @@ fn recalled_cycles_repeat_the_solved_ones() {
 /// 0.05 ηP) through three ±½ ηP cycles, with and without. The states are the same to the
 /// solver's tolerance and the steps take fewer residual evaluations. Measured (with the
 /// projected update, `SlipOptions::projected_updates`): 448 against 508 evaluations at the
-/// solver tolerance 1e−11 (twenty-fourth session); 510–512 against 567–574 at 1e−13 over the
-/// twentieth session's builds. The count without the option moves by about 1 % with
-/// the round-off of the products and quadratures (574, 573 and 568 over three builds of the
-/// eighteenth session that differ in round-off only, with it 511 or 512), so the bound, nine
-/// tenths until then (measured 0.89), is nineteen twentieths; the records differ by at most
-/// 1.2e−11 a in the geometry and δ and 9.8e−11 of the largest step dissipation (at 1e−13:
-/// 2.1e−13 a and 1.4e−12; bounds [`assert_same_states`]). The second steps of the reversal
+/// solver tolerance 1e−11. The count without the option moves by about 1 % with the
+/// round-off of the products and quadratures, so the bound is nineteen twentieths; the
+/// records differ by at most 1.2e−11 a in the geometry and δ and 9.8e−11 of the largest step
+/// dissipation (bounds [`assert_same_states`]). The second steps of the reversal
 /// phases, which change from mixed slip signs back to the standard ones, take the coarse
-/// grid's Jacobian too: 7, 7 and 7 evaluations against 10, 10 and 10 (8 against 11 at 1e−13;
-/// a fine finite-difference Jacobian without it).
+/// grid's Jacobian too: 7, 7 and 7 evaluations against 10, 10 and 10 (without it they take a
+/// fine finite-difference Jacobian).
 #[test]
 fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
     let b = baseline(96);
@@ -1568,8 +1558,7 @@ fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
 /// solver's tolerance (bounds as for recalled steps) and the steps take fewer residual
 /// evaluations. Measured at the solver tolerance 1e−11: 514 against 591 evaluations (bound
 /// nine tenths); the records differ by at most 1.3e−11 a in the geometry and δ and 1.8e−10 of
-/// the largest step dissipation (at 1e−13 over the twentieth session's builds: 581–585
-/// against 663–667, 1.5e−13 a and 2.6e−12).
+/// the largest step dissipation.
 #[test]
 fn projected_updates_reach_the_same_states_in_fewer_evaluations() {
     let b = baseline(32);
@@ -1588,8 +1577,7 @@ fn projected_updates_reach_the_same_states_in_fewer_evaluations() {
 /// are the same to the solver's tolerance (bounds as for recalled steps). Measured at the
 /// solver tolerance 1e−11: phases 3 and 4 take 11 and 11 evaluations against 19 and 18 (after
 /// the standard pattern's inadmissible attempt, as without); the records differ by at most
-/// 1.2e−12 a in the geometry and δ and 3.9e−13 of the largest step dissipation (at 1e−13 over
-/// the twentieth session's builds: 13 and 12 against 20 and 19, 4.5e−14 a and 9.6e−13).
+/// 1.2e−12 a in the geometry and δ and 3.9e−13 of the largest step dissipation.
 #[test]
 fn later_reversals_start_from_the_last_mixed_pattern() {
     let b = baseline(32);
@@ -1625,9 +1613,7 @@ fn later_reversals_start_from_the_last_mixed_pattern() {
 /// at 0.4 ηP begins mixed again and takes its mixed attempt from the remembered edge, which the
 /// standard phase start between did not replace. Measured at the solver tolerance 1e−11: the
 /// phase starts at steps 21, 37 and 49 take 18, 11 and 11 evaluations against 18, 11 and 24;
-/// the records differ by at most 4.3e−13 a and 4.2e−14 of the largest step dissipation (at
-/// 1e−13 over the twentieth session's builds: 19, 11 and 12 against 19, 11 and 27, 3.7e−14 a
-/// and 2.5e−14).
+/// the records differ by at most 4.3e−13 a and 4.2e−14 of the largest step dissipation.
 #[test]
 fn phase_starts_keep_the_standard_pattern_where_it_passes() {
     let b = baseline(64);
