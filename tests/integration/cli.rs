@@ -7,11 +7,11 @@ use std::process::Command;
 
 use serde::Deserialize;
 
-fn fretsim() -> Command {
+pub(crate) fn fretsim() -> Command {
     Command::new(env!("CARGO_BIN_EXE_fretsim"))
 }
 
-fn scenario_path(name: &str) -> PathBuf {
+pub(crate) fn scenario_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("scenarios")
         .join(format!("{name}.json"))

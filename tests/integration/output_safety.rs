@@ -3,18 +3,10 @@
 //! every stage, the lock against two runs on one folder, and the exit statuses of failures.
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 
-fn fretsim() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_fretsim"))
-}
-
-fn scenario_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenarios")
-        .join(format!("{name}.json"))
-}
+use crate::cli::{fretsim, scenario_path};
 
 /// Every file under `dir` with its contents, sorted: a folder's complete state.
 fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
