@@ -100,6 +100,25 @@ pub struct RunResult {
     pub fields: Vec<FieldSet>,
 }
 
+/// Everything a run computes, before anything is written: what [`solve`] returns and what
+/// the output files are made of.
+#[derive(Debug)]
+pub struct Solution {
+    /// The summary (`summary.json`).
+    pub summary: Summary,
+    /// The sampled fields: the end of normal loading, then one set per snapshot time reached.
+    pub fields: Vec<FieldSet>,
+    /// The fields at the turning points and the last step (empty when
+    /// `output.turning_point_fields` is off).
+    pub turning_fields: Vec<FieldSet>,
+    /// One record per accepted step (step 0 is the end of normal loading).
+    pub records: Vec<crate::history::StepRecord>,
+    /// The cycles of the history.
+    pub cycles: Vec<CycleRow>,
+    /// The solver failure that stopped the history part-way, if any.
+    pub failure: Option<Error>,
+}
+
 /// Derived constants of a model at normal load P.
 pub fn derived(model: &ContactModel, normal_load: f64) -> Derived {
     let split = model.charge_split(normal_load);
@@ -331,20 +350,42 @@ pub fn run_partial(
     observer: &mut dyn crate::history::Observer,
 ) -> Result<(RunResult, Option<Error>), Error> {
     crate::output::pause_point("solve");
-    let model = &scenario.model;
-    let disc = Discretisation::new(scenario.collocation_points);
-    let normal = match solve_normal(model, &disc, scenario.normal_load, NormalOptions::default()) {
-        Ok(normal) => normal,
-        Err(failure) => {
-            let error = Error::Solve {
-                context: "normal loading".into(),
+    match solve(scenario, observer) {
+        Ok(mut solution) => {
+            let out_dir = write_solution(folder, scenario, &solution)?;
+            let failure = solution.failure.take();
+            Ok((
+                RunResult {
+                    out_dir,
+                    summary: solution.summary,
+                    fields: solution.fields,
+                },
                 failure,
-            };
+            ))
+        }
+        Err(error) => {
             folder.write("failure.json", &failure_json(&error, None))?;
             folder.commit()?;
-            return Err(error);
+            Err(error)
         }
-    };
+    }
+}
+
+/// Solve a validated scenario: the normal loading, then the tangential history if any, and
+/// the fields and the summary made from them. Writes nothing. A failure of the normal loading
+/// is an `Err`; a failure part-way through the history is returned in
+/// [`Solution::failure`] beside the steps solved before it.
+pub fn solve(
+    scenario: &Scenario,
+    observer: &mut dyn crate::history::Observer,
+) -> Result<Solution, Error> {
+    let model = &scenario.model;
+    let disc = Discretisation::new(scenario.collocation_points);
+    let normal = solve_normal(model, &disc, scenario.normal_load, NormalOptions::default())
+        .map_err(|failure| Error::Solve {
+            context: "normal loading".into(),
+            failure,
+        })?;
     let mut warnings = Vec::new();
     let gamma1 = model.pressure_charge(scenario.normal_load);
     let gap = model.outside_gap(&normal.state);
@@ -485,30 +526,54 @@ pub fn run_partial(
         warnings,
     };
     // Turning points and the last step, unless switched off.
-    let mut turning: Vec<&(crate::history::StepRecord, crate::contact::ContactState)> = Vec::new();
+    let mut turning_fields = Vec::new();
     if scenario.raw.output.turning_point_fields {
-        turning.extend(snapshots.kept.iter());
-        turning.extend(snapshots.previous.iter());
+        for (rec, state) in snapshots.kept.iter().chain(snapshots.previous.iter()) {
+            turning_fields.push(FieldSet {
+                stem: format!("step_{:05}", rec.step),
+                label: format!("step {}", rec.step),
+                points: sample(state),
+            });
+        }
     }
+    Ok(Solution {
+        summary,
+        fields,
+        turning_fields,
+        records,
+        cycles,
+        failure,
+    })
+}
+
+/// Write a solution's files into its claimed folder and swap the folder into place.
+fn write_solution(
+    mut folder: RunFolder,
+    scenario: &Scenario,
+    solution: &Solution,
+) -> Result<PathBuf, Error> {
+    let Solution {
+        summary,
+        fields,
+        turning_fields,
+        records,
+        cycles,
+        failure,
+    } = solution;
+    let limit = scenario.model.friction * scenario.normal_load;
     let mut sections = Vec::new();
     {
         let mut put = |name: String, bytes: &[u8]| folder.write(&name, bytes);
         put(
             "summary.json".into(),
-            &serde_json::to_vec_pretty(&summary).expect("summary serialises"),
+            &serde_json::to_vec_pretty(summary).expect("summary serialises"),
         )?;
         if scenario.history.is_some() {
-            put("steps.csv".into(), &steps_csv(&records, limit))?;
-            put("cycles.csv".into(), &cycles_csv(&cycles))?;
+            put("steps.csv".into(), &steps_csv(records, limit))?;
+            put("cycles.csv".into(), &cycles_csv(cycles))?;
         }
-        for set in &fields {
+        for set in fields.iter().chain(turning_fields) {
             put(format!("fields/{}.csv", set.stem), &fields_csv(&set.points))?;
-        }
-        for (rec, state) in turning {
-            put(
-                format!("fields/step_{:05}.csv", rec.step),
-                &fields_csv(&sample(state)),
-            )?;
         }
         let mut section = |title: &str, plots: Vec<(String, String)>| -> Result<(), Error> {
             let mut names = Vec::new();
@@ -527,7 +592,7 @@ pub fn run_partial(
         )?;
         section(
             "Load history",
-            history_plots(&records, limit, failure.is_some()),
+            history_plots(records, limit, failure.is_some()),
         )?;
         let instants: Vec<(&str, &[SurfacePoint])> = fields[1..]
             .iter()
@@ -538,7 +603,7 @@ pub fn run_partial(
             family_plots("snapshots", "at the snapshot instants", &instants),
         )?;
     }
-    if let Some(e) = &failure {
+    if let Some(e) = failure {
         folder.write("failure.json", &failure_json(e, records.last()))?;
     }
     let mut written = folder.files().to_vec();
@@ -547,15 +612,7 @@ pub fn run_partial(
         "index.html",
         index_html(&scenario.name, &sections, &written).as_bytes(),
     )?;
-    let out_dir = folder.commit()?;
-    Ok((
-        RunResult {
-            out_dir,
-            summary,
-            fields,
-        },
-        failure,
-    ))
+    folder.commit()
 }
 
 /// `failure.json`: the error and the last accepted step (none when normal loading failed).

@@ -25,6 +25,24 @@
 //! collocation ([`quadrature`]) with the contact geometry (a, c, stick-zone ends) fixed by the
 //! consistency conditions of bounded solutions ([`contact`]).
 //!
+//! ## Use as a library
+//! [`scenario::parse`] and [`scenario::validate`] (or [`scenario::load`] for a file) give a
+//! [`scenario::Scenario`]; [`app::solve`] solves it and writes nothing; [`app::run`] also
+//! writes the output folder that `fretsim run` writes.
+//!
+//! ```
+//! use fretsim::{app, history::NoObserver, scenario};
+//!
+//! // The built-in scenario: PZT-4, conducting punch, P = 2000 N/m, three cycles of ±0.5 ηP.
+//! let scenario = scenario::default_scenario();
+//! let solution = app::solve(&scenario, &mut NoObserver).expect("the default scenario solves");
+//! let normal = &solution.summary.normal_loading;
+//! assert!((normal.pressure_resultant - 2000.0).abs() < 1e-6); // ∫p dx = P
+//! assert!(normal.stick_ratio > 0.0 && normal.stick_ratio < 1.0); // slip zones at both ends
+//! let history = solution.summary.history.as_ref().expect("it has a history");
+//! println!("{} steps, {} cycles", history.steps, history.cycles.len());
+//! ```
+//!
 //! ## Symbols
 //! | symbol | meaning | unit |
 //! |---|---|---|
