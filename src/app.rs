@@ -961,6 +961,9 @@ fn steps_csv(records: &[crate::history::StepRecord], limit: f64) -> Vec<u8> {
     w.into_inner().expect("in-memory write")
 }
 
+/// Most variants in a sweep (the product of the `--vary` counts).
+pub const MAX_SWEEP_VARIANTS: usize = 100_000;
+
 /// One varied field of a sweep: `path=start:end:count` (linear spacing, count ≥ 1).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Vary {
@@ -991,6 +994,11 @@ impl std::str::FromStr for Vary {
             .map_err(|_| format!("COUNT `{count}` is not a whole number"))?;
         if count == 0 || !start.is_finite() || !end.is_finite() {
             return Err("COUNT must be ≥ 1 and START, END finite".into());
+        }
+        if count > MAX_SWEEP_VARIANTS {
+            return Err(format!(
+                "COUNT {count} is invalid; it must be at most {MAX_SWEEP_VARIANTS} (variants in a sweep)"
+            ));
         }
         let values = (0..count)
             .map(|i| {
@@ -1036,6 +1044,38 @@ impl std::str::FromStr for Shard {
     }
 }
 
+/// Whether the scenario field at dotted `path` is an integer: its value in the built-in
+/// default scenario with every field written out (the schema; a float field written as `2000`
+/// in a file stays a float).
+fn is_integer_field(path: &str) -> bool {
+    static SCHEMA: std::sync::OnceLock<serde_json::Value> = std::sync::OnceLock::new();
+    let schema = SCHEMA.get_or_init(|| {
+        serde_json::to_value(&crate::scenario::default_scenario().raw).unwrap_or_default()
+    });
+    path.split('.')
+        .try_fold(schema, |v, k| v.get(k))
+        .is_some_and(|v| v.is_u64() || v.is_i64())
+}
+
+/// `x` as the JSON value of the field at `path`: an integer for an integer field (an error
+/// unless `x` is a whole number), else a float.
+fn field_value(path: &str, x: f64) -> Result<serde_json::Value, String> {
+    if !is_integer_field(path) {
+        return Ok(serde_json::json!(x));
+    }
+    if !(x.is_finite() && x.fract() == 0.0) {
+        return Err(format!(
+            "{x} is invalid; it must be a whole number (the field is an integer)"
+        ));
+    }
+    // Beyond 2^53 the integer is not exact; the scenario's parser then names the field.
+    Ok(if x.abs() <= 2f64.powi(53) {
+        serde_json::json!(x as i64)
+    } else {
+        serde_json::json!(x)
+    })
+}
+
 fn set_path(value: &mut serde_json::Value, path: &str, x: f64) -> Result<(), String> {
     let mut cur = value;
     let keys: Vec<&str> = path.split('.').collect();
@@ -1044,7 +1084,7 @@ fn set_path(value: &mut serde_json::Value, path: &str, x: f64) -> Result<(), Str
             .as_object_mut()
             .ok_or_else(|| format!("`{path}`: `{}` is not an object", keys[..i].join(".")))?;
         if i + 1 == keys.len() {
-            obj.insert((*k).to_string(), serde_json::json!(x));
+            obj.insert((*k).to_string(), field_value(path, x)?);
             return Ok(());
         }
         cur = obj
@@ -1052,6 +1092,61 @@ fn set_path(value: &mut serde_json::Value, path: &str, x: f64) -> Result<(), Str
             .or_insert_with(|| serde_json::json!({}));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod vary_tests {
+    use super::*;
+
+    #[test]
+    fn a_vary_count_above_the_variant_limit_is_rejected() {
+        assert_eq!(
+            "friction=0:1:100001".parse::<Vary>().unwrap_err(),
+            "COUNT 100001 is invalid; it must be at most 100000 (variants in a sweep)"
+        );
+        assert!("friction=0:1:100000".parse::<Vary>().is_ok());
+    }
+
+    #[test]
+    fn a_sweep_product_above_the_variant_limit_is_rejected() {
+        let vary: Vec<Vary> = ["friction=0.1:0.3:1000", "normal_load=1000:2000:101"]
+            .iter()
+            .map(|v| v.parse().unwrap())
+            .collect();
+        let text = crate::scenario::DEFAULT_SCENARIO;
+        match sweep_variants(text, Path::new("t.json"), &vary, None) {
+            Err(e @ Error::InvalidScenario { .. }) => assert_eq!(
+                e.to_string(),
+                "t.json: 1 problem(s)\n  - `--vary` = 1000 × 101 variants is invalid; it must be at most 100000"
+            ),
+            other => panic!("{:?}", other.map(|v| v.len())),
+        }
+    }
+
+    #[test]
+    fn integer_fields_receive_integers() {
+        let mut v = serde_json::json!({"numerics": {"collocation_points": 64}, "friction": 0.3});
+        set_path(&mut v, "numerics.collocation_points", 32.0).unwrap();
+        set_path(&mut v, "tangential_history.repeats", 5.0).unwrap();
+        set_path(&mut v, "friction", 1.0).unwrap();
+        assert_eq!(v["numerics"]["collocation_points"], serde_json::json!(32));
+        assert!(v["tangential_history"]["repeats"].is_u64());
+        assert!(v["friction"].is_f64());
+        assert_eq!(
+            set_path(&mut v, "output.field_points", 402.5).unwrap_err(),
+            "402.5 is invalid; it must be a whole number (the field is an integer)"
+        );
+        // A sweep over M runs (it failed to parse when M was written as a float).
+        let vary = vec![
+            "numerics.collocation_points=16:32:2"
+                .parse::<Vary>()
+                .unwrap(),
+        ];
+        let text = crate::scenario::DEFAULT_SCENARIO;
+        let variants = sweep_variants(text, Path::new("t.json"), &vary, None).unwrap();
+        let m: Vec<usize> = variants.iter().map(|v| v.2.collocation_points).collect();
+        assert_eq!(m, [16, 32]);
+    }
 }
 
 /// Options of a sweep.
@@ -1129,6 +1224,23 @@ fn sweep_variants(
         column: e.column(),
         message: e.to_string(),
     })?;
+    let total = vary
+        .iter()
+        .try_fold(1usize, |n, v| n.checked_mul(v.values.len()))
+        .filter(|&n| n <= MAX_SWEEP_VARIANTS);
+    if total.is_none() {
+        let counts: Vec<String> = vary.iter().map(|v| v.values.len().to_string()).collect();
+        return Err(Error::InvalidScenario {
+            path: source.to_path_buf(),
+            issues: vec![crate::error::Issue::new(
+                "--vary",
+                format!(
+                    "{} variants is invalid; it must be at most {MAX_SWEEP_VARIANTS}",
+                    counts.join(" × ")
+                ),
+            )],
+        });
+    }
     // Cartesian product of the values.
     let mut combos: Vec<Vec<f64>> = vec![Vec::new()];
     for v in vary {

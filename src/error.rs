@@ -84,6 +84,39 @@ pub enum SolveFailure {
     },
 }
 
+/// Why the surface response of a half-plane could not be computed from its constants
+/// ([`crate::halfplane::SurfaceCompliance::try_of`]): constants that pass the range checks but
+/// are degenerate for the extended Stroh eigenproblem.
+#[derive(Debug, Clone, PartialEq, thiserror::Error, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum MaterialFailure {
+    /// A matrix the construction inverts is singular.
+    #[error("the {matrix} is singular")]
+    Singular {
+        /// Which matrix.
+        matrix: &'static str,
+    },
+    /// The matrix sign iteration did not reach a sign matrix (an eigenvalue of the Stroh
+    /// matrix on or near the real axis: no split into decaying and growing modes).
+    #[error(
+        "the Stroh matrix has no clean split into decaying and growing modes (matrix sign residual {residual:.3e})"
+    )]
+    NoModeSplit {
+        /// `‖S² − I‖/‖S‖²` of the last iterate (NaN if it is not finite).
+        residual: f64,
+    },
+    /// A surface compliance coefficient came out non-finite or of the wrong sign.
+    #[error("the surface compliance {coefficient} = {value:e} is not {rule}")]
+    Compliance {
+        /// Which coefficient (`y11`, `y22`, `y33`, …).
+        coefficient: &'static str,
+        /// Its value (SI).
+        value: f64,
+        /// What it must be.
+        rule: &'static str,
+    },
+}
+
 /// Errors of the library and the command line.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {

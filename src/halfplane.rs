@@ -53,6 +53,7 @@
 use nalgebra::{Complex, Matrix3, Matrix6};
 use serde::Serialize;
 
+use crate::error::MaterialFailure;
 use crate::material::{IsotropicConstants, Material, PiezoConstants};
 
 type C64 = Complex<f64>;
@@ -104,12 +105,55 @@ pub struct SurfaceFieldCoefficients {
 }
 
 impl SurfaceCompliance {
-    /// Coefficients for a material.
-    pub fn of(material: &Material) -> Self {
-        match material {
-            Material::Piezoelectric(c) => piezoelectric(c),
+    /// Coefficients for a material, or why the constants give no decaying solution (a
+    /// degenerate Stroh eigenproblem, or non-finite or wrongly signed coefficients).
+    pub fn try_of(material: &Material) -> Result<Self, MaterialFailure> {
+        let out = match material {
+            Material::Piezoelectric(c) => piezoelectric(c)?,
             Material::Elastic(c) => isotropic(c),
+        };
+        out.check()?;
+        Ok(out)
+    }
+
+    /// Coefficients for a material known to be sound (the presets, tests).
+    ///
+    /// # Panics
+    /// If [`Self::try_of`] fails; use that on constants from the user.
+    pub fn of(material: &Material) -> Self {
+        Self::try_of(material).unwrap_or_else(|e| panic!("surface compliance: {e}"))
+    }
+
+    /// Every coefficient finite, `y11, y22 > 0` (a surface compliance is positive) and, for a
+    /// piezoelectric solid, `y33 < 0` (a dielectric), so that `Y* ≥ y22 > 0`.
+    fn check(&self) -> Result<(), MaterialFailure> {
+        let e = self.electric;
+        // (coefficient, value, required sign: +1 positive, −1 negative, 0 any).
+        let rules = [
+            ("y11", self.y11, 1.0),
+            ("y22", self.y22, 1.0),
+            ("w12", self.w12, 0.0),
+            ("y23", e.map_or(0.0, |e| e.y23), 0.0),
+            ("y33", e.map_or(-1.0, |e| e.y33), -1.0),
+            ("w13", e.map_or(0.0, |e| e.w13), 0.0),
+        ];
+        for (coefficient, value, sign) in rules {
+            let (holds, rule) = if sign > 0.0 {
+                (value > 0.0, "finite and > 0")
+            } else if sign < 0.0 {
+                (value < 0.0, "finite and < 0")
+            } else {
+                (true, "finite")
+            };
+            if !(value.is_finite() && holds) {
+                return Err(MaterialFailure::Compliance {
+                    coefficient,
+                    value,
+                    rule,
+                });
+            }
         }
+        Ok(())
     }
 
     /// `Y* = y22 − y23²/y33`: compliance of the pressure problem once the charge is eliminated
@@ -191,11 +235,17 @@ struct Scales {
     eps0: f64,
 }
 
-/// `Y = i A B⁻¹` for the decaying modes of the Stroh matrix built from (Q, R, T).
-fn surface_admittance(q: &Matrix3<f64>, r: &Matrix3<f64>, t: &Matrix3<f64>) -> Matrix3<C64> {
-    let t_inv = t
-        .try_inverse()
-        .expect("T block of a valid material is invertible");
+/// `Y = i A B⁻¹` for the decaying modes of the Stroh matrix built from (Q, R, T); an error
+/// when the constants are degenerate (a singular block, no split into decaying and growing
+/// modes).
+fn surface_admittance(
+    q: &Matrix3<f64>,
+    r: &Matrix3<f64>,
+    t: &Matrix3<f64>,
+) -> Result<Matrix3<C64>, MaterialFailure> {
+    let t_inv = t.try_inverse().ok_or(MaterialFailure::Singular {
+        matrix: "z-z block T of the generalised constants",
+    })?;
     let n1 = -t_inv * r.transpose();
     let n3 = r * t_inv * r.transpose() - q;
     let n4 = -r * t_inv;
@@ -206,10 +256,12 @@ fn surface_admittance(q: &Matrix3<f64>, r: &Matrix3<f64>, t: &Matrix3<f64>) -> M
     n.fixed_view_mut::<3, 3>(3, 3).copy_from(&n4);
     // Matrix sign of Z = −iN: eigenvalue −ip has real part Im p.
     let mut s: Matrix6<C64> = n.map(|v| C64::new(0.0, -v));
+    let no_split = |s: &Matrix6<C64>| MaterialFailure::NoModeSplit {
+        residual: (s * s - Matrix6::<C64>::identity()).norm() / s.norm_squared(),
+    };
     for _ in 0..100 {
-        let inv = s
-            .try_inverse()
-            .expect("Stroh matrix has no real eigenvalue");
+        // Singular: an eigenvalue of N on the real axis.
+        let inv = s.try_inverse().ok_or_else(|| no_split(&s))?;
         // Determinant scaling accelerates the first iterations.
         let mu = s.determinant().norm().powf(-1.0 / 6.0);
         let next = (s * C64::new(mu, 0.0) + inv * C64::new(1.0 / mu, 0.0)) * C64::new(0.5, 0.0);
@@ -219,22 +271,29 @@ fn surface_admittance(q: &Matrix3<f64>, r: &Matrix3<f64>, t: &Matrix3<f64>) -> M
             break;
         }
     }
+    // A sign matrix squares to I; the iteration ends far below this bound when it converges.
+    let failed = no_split(&s);
+    if !matches!(failed, MaterialFailure::NoModeSplit { residual } if residual < 1e-8) {
+        return Err(failed);
+    }
     let p_plus = (Matrix6::<C64>::identity() + s) * C64::new(0.5, 0.0);
     let p12 = p_plus.fixed_view::<3, 3>(0, 3).into_owned();
     let p22 = p_plus.fixed_view::<3, 3>(3, 3).into_owned();
-    let a_binv = p12 * p22.try_inverse().expect("surface impedance is invertible");
-    a_binv * C64::new(0.0, 1.0)
+    let p22_inv = p22.try_inverse().ok_or(MaterialFailure::Singular {
+        matrix: "traction block of the decaying modes' projector (surface impedance)",
+    })?;
+    Ok(p12 * p22_inv * C64::new(0.0, 1.0))
 }
 
-fn piezoelectric(c: &PiezoConstants) -> SurfaceCompliance {
+fn piezoelectric(c: &PiezoConstants) -> Result<SurfaceCompliance, MaterialFailure> {
     let (q, r, t, sc) = stroh_blocks(c);
-    let y = surface_admittance(&q, &r, &t);
+    let y = surface_admittance(&q, &r, &t)?;
     // Undo the scaling: t̃ = (σ/c0, σ/c0, D/e0), ũ = (ux, uz, φ·e0/c0).
     let mech = 1.0 / sc.c0;
     let cross = 1.0 / sc.e0;
     let elec = 1.0 / sc.eps0;
     let (yr, yi) = (y.map(|z| z.re), y.map(|z| z.im));
-    SurfaceCompliance {
+    Ok(SurfaceCompliance {
         y11: yr[(0, 0)] * mech,
         y22: yr[(1, 1)] * mech,
         w12: yi[(0, 1)] * mech,
@@ -243,13 +302,13 @@ fn piezoelectric(c: &PiezoConstants) -> SurfaceCompliance {
             y33: yr[(2, 2)] * elec,
             w13: yi[(0, 2)] * cross,
         }),
-    }
+    })
 }
 
 /// Full dimensional `Y = Y_R + i Y_I` for a piezoelectric material (for the reciprocity tests).
-pub fn admittance_matrix(c: &PiezoConstants) -> [[(f64, f64); 3]; 3] {
+pub fn admittance_matrix(c: &PiezoConstants) -> Result<[[(f64, f64); 3]; 3], MaterialFailure> {
     let (q, r, t, sc) = stroh_blocks(c);
-    let y = surface_admittance(&q, &r, &t);
+    let y = surface_admittance(&q, &r, &t)?;
     let scale = [1.0 / sc.c0, 1.0 / sc.c0, 1.0 / sc.e0];
     let mut out = [[(0.0, 0.0); 3]; 3];
     for i in 0..3 {
@@ -265,7 +324,7 @@ pub fn admittance_matrix(c: &PiezoConstants) -> [[(f64, f64); 3]; 3] {
             out[i][j] = (y[(i, j)].re * s, y[(i, j)].im * s);
         }
     }
-    out
+    Ok(out)
 }
 
 impl SurfaceFieldCoefficients {
@@ -362,13 +421,38 @@ mod tests {
     }
 
     #[test]
+    fn degenerate_constants_give_an_error_not_a_panic() {
+        // Finite constants far outside the validated ranges (fuzz finds): the Stroh solution
+        // fails, and says so.
+        for c in [
+            PiezoConstants {
+                c44: 2.56e-90,
+                ..PZT4
+            },
+            PiezoConstants {
+                e15: 1.27e301,
+                ..PZT4
+            },
+            PiezoConstants {
+                eps11: 1e308,
+                ..PZT4
+            },
+        ] {
+            let m = Material::Piezoelectric(c);
+            assert!(SurfaceCompliance::try_of(&m).is_err(), "{c:?}");
+            assert!(admittance_matrix(&c).is_err(), "{c:?}");
+        }
+        assert!(SurfaceCompliance::try_of(&Material::Piezoelectric(PZT4)).is_ok());
+    }
+
+    #[test]
     fn admittance_is_hermitian_reciprocity() {
         for scale in [1.0, 0.3, 1e-3] {
             let m = Material::Piezoelectric(PZT4).with_scaled_coupling(scale);
             let Material::Piezoelectric(c) = m else {
                 unreachable!()
             };
-            let y = admittance_matrix(&c);
+            let y = admittance_matrix(&c).unwrap();
             for i in 0..3 {
                 for j in 0..3 {
                     let (a, b) = (y[i][j], y[j][i]);
@@ -411,7 +495,7 @@ mod tests {
                 eps11: 1e-8,
                 eps33: 1e-8,
             };
-            let stroh = piezoelectric(&c);
+            let stroh = piezoelectric(&c).unwrap();
             let exact = isotropic(&iso);
             assert_relative_eq!(stroh.y11, exact.y11, max_relative = 1e-10);
             assert_relative_eq!(stroh.y22, exact.y22, max_relative = 1e-10);
@@ -440,7 +524,8 @@ mod tests {
             e33: 0.0,
             e15: 0.0,
             ..PZT4
-        });
+        })
+        .unwrap();
         let mut previous = f64::INFINITY;
         for scale in [1e-1, 1e-2, 1e-3] {
             let s =

@@ -15,10 +15,14 @@
 //! Only the in-plane constants enter a plane problem, so `c12`/`c66` are not needed.
 //!
 //! # Validity
-//! A material is accepted when every constant is finite, the in-plane elastic matrix
-//! `[[c11, c13], [c13, c33]]` and `c44` are positive definite, and `ε11, ε33 > 0`; an isotropic
-//! solid needs `μ > 0` (or `E > 0`) and `−1 < ν ≤ 1/2` (`ν = 1/2`, the incompressible limit,
-//! is allowed: it is the uncoupled case of Dundurs' β = 0 used for the Cattaneo–Mindlin checks).
+//! A material is accepted when every constant is finite and physical — `c11, c33, c44` (and
+//! `|c13|`) in [1e3, 1e14] Pa, `|e31|, |e33|, |e15| ≤ 1e3` C/m², `ε11, ε33` in [1e−14, 1e−3]
+//! C/(V·m) — the in-plane elastic matrix `[[c11, c13], [c13, c33]]` and `c44` are positive
+//! definite, and `ε11, ε33 > 0`; an isotropic solid needs `μ` (or `E`) in [1e3, 1e14] Pa and
+//! `−1 < ν ≤ 1/2` (`ν = 1/2`, the incompressible limit, is allowed: it is the uncoupled case of
+//! Dundurs' β = 0 used for the Cattaneo–Mindlin checks). Constants inside these ranges can still
+//! be degenerate for the surface response; [`crate::halfplane::SurfaceCompliance::try_of`]
+//! then says why.
 
 use serde::{Deserialize, Serialize};
 
@@ -192,87 +196,165 @@ fn normalise_name(name: &str) -> String {
         .collect()
 }
 
-impl Material {
-    /// Every problem with the constants, each naming the constant (`path` is prefixed).
+/// Range of an elastic constant (Pa): a stiffness from a soft rubber to beyond diamond. Inside
+/// it, and with the other ranges, the dimensionless constants of the Stroh eigenproblem stay
+/// representable.
+pub const STIFFNESS_RANGE: (f64, f64) = (1e3, 1e14);
+/// Largest |e_ij| (C/m²) of a piezoelectric constant (ceramics and crystals have |e| < 100).
+pub const MAX_PIEZOELECTRIC: f64 = 1e3;
+/// Range of a permittivity (C/(V·m)); vacuum has 8.85e−12, ferroelectrics up to about 1e−6.
+pub const PERMITTIVITY_RANGE: (f64, f64) = (1e-14, 1e-3);
+
+/// An issue unless `value` lies in `[lo, hi]` (NaN does not).
+fn check_range(
+    issues: &mut Vec<Issue>,
+    path: String,
+    value: f64,
+    unit: &str,
+    (lo, hi): (f64, f64),
+) {
+    if !(lo..=hi).contains(&value) {
+        issues.push(Issue::new(
+            path,
+            format!("{value:e} {unit} is invalid; it must lie in [{lo:e}, {hi:e}] {unit}"),
+        ));
+    }
+}
+
+/// The rules of Young's modulus `E` (Pa) and Poisson's ratio `ν` of an isotropic solid given
+/// by them (`path` is prefixed): `E` in [`STIFFNESS_RANGE`], `−1 < ν ≤ 1/2`.
+pub fn validate_youngs(path: &str, youngs_modulus: f64, poisson_ratio: f64) -> Vec<Issue> {
+    let mut issues = Vec::new();
+    check_range(
+        &mut issues,
+        format!("{path}.youngs_modulus"),
+        youngs_modulus,
+        "Pa",
+        STIFFNESS_RANGE,
+    );
+    check_poisson(&mut issues, path, poisson_ratio);
+    issues
+}
+
+fn check_poisson(issues: &mut Vec<Issue>, path: &str, nu: f64) {
+    if !(nu.is_finite() && nu > -1.0 && nu <= 0.5) {
+        issues.push(Issue::new(
+            format!("{path}.poisson_ratio"),
+            format!("{nu} is invalid; it must lie in (−1, 0.5]"),
+        ));
+    }
+}
+
+impl PiezoConstants {
+    /// Every problem with the constants, each naming the constant (`path` is prefixed):
+    /// finite, in range, and the elastic and dielectric matrices positive definite.
     pub fn validate(&self, path: &str) -> Vec<Issue> {
+        let c = self;
         let mut issues = Vec::new();
-        match self {
-            Material::Piezoelectric(c) => {
-                let named = [
-                    ("c11", c.c11, "Pa"),
-                    ("c13", c.c13, "Pa"),
-                    ("c33", c.c33, "Pa"),
-                    ("c44", c.c44, "Pa"),
-                    ("e31", c.e31, "C/m²"),
-                    ("e33", c.e33, "C/m²"),
-                    ("e15", c.e15, "C/m²"),
-                    ("eps11", c.eps11, "C/(V·m)"),
-                    ("eps33", c.eps33, "C/(V·m)"),
-                ];
-                for (name, value, unit) in named {
-                    if !value.is_finite() {
-                        issues.push(Issue::new(
-                            format!("{path}.{name}"),
-                            format!("{value} {unit} is invalid; it must be finite"),
-                        ));
-                    }
-                }
-                if !issues.is_empty() {
-                    return issues;
-                }
-                for (name, value, unit) in [
-                    ("c11", c.c11, "Pa"),
-                    ("c33", c.c33, "Pa"),
-                    ("c44", c.c44, "Pa"),
-                ] {
-                    if value <= 0.0 {
-                        issues.push(Issue::new(
-                            format!("{path}.{name}"),
-                            format!("{value:e} {unit} is invalid; it must be > 0 (elastic stiffness positive definite)"),
-                        ));
-                    }
-                }
-                if c.c11 > 0.0 && c.c33 > 0.0 && c.c11 * c.c33 - c.c13 * c.c13 <= 0.0 {
-                    issues.push(Issue::new(
-                        format!("{path}.c13"),
-                        format!(
-                            "{:e} Pa is invalid; it must satisfy c13² < c11·c33 = {:e} Pa² (elastic stiffness positive definite)",
-                            c.c13,
-                            c.c11 * c.c33
-                        ),
-                    ));
-                }
-                for (name, value) in [("eps11", c.eps11), ("eps33", c.eps33)] {
-                    if value <= 0.0 {
-                        issues.push(Issue::new(
-                            format!("{path}.{name}"),
-                            format!("{value:e} C/(V·m) is invalid; it must be > 0 (permittivity positive definite)"),
-                        ));
-                    }
-                }
+        let named = [
+            ("c11", c.c11, "Pa"),
+            ("c13", c.c13, "Pa"),
+            ("c33", c.c33, "Pa"),
+            ("c44", c.c44, "Pa"),
+            ("e31", c.e31, "C/m²"),
+            ("e33", c.e33, "C/m²"),
+            ("e15", c.e15, "C/m²"),
+            ("eps11", c.eps11, "C/(V·m)"),
+            ("eps33", c.eps33, "C/(V·m)"),
+        ];
+        for (name, value, unit) in named {
+            if !value.is_finite() {
+                issues.push(Issue::new(
+                    format!("{path}.{name}"),
+                    format!("{value} {unit} is invalid; it must be finite"),
+                ));
             }
-            Material::Elastic(c) => {
-                if !(c.shear_modulus.is_finite() && c.shear_modulus > 0.0) {
-                    issues.push(Issue::new(
-                        format!("{path}.shear_modulus"),
-                        format!(
-                            "{:e} Pa is invalid; it must be finite and > 0",
-                            c.shear_modulus
-                        ),
-                    ));
-                }
-                if !(c.poisson_ratio.is_finite()
-                    && c.poisson_ratio > -1.0
-                    && c.poisson_ratio <= 0.5)
-                {
-                    issues.push(Issue::new(
-                        format!("{path}.poisson_ratio"),
-                        format!("{} is invalid; it must lie in (−1, 0.5]", c.poisson_ratio),
-                    ));
-                }
+        }
+        if !issues.is_empty() {
+            return issues;
+        }
+        for (name, value) in [("c11", c.c11), ("c33", c.c33), ("c44", c.c44)] {
+            if value <= 0.0 {
+                issues.push(Issue::new(
+                    format!("{path}.{name}"),
+                    format!("{value:e} Pa is invalid; it must be > 0 (elastic stiffness positive definite)"),
+                ));
+            } else {
+                check_range(
+                    &mut issues,
+                    format!("{path}.{name}"),
+                    value,
+                    "Pa",
+                    STIFFNESS_RANGE,
+                );
+            }
+        }
+        if c.c13.abs() > STIFFNESS_RANGE.1 {
+            let max = STIFFNESS_RANGE.1;
+            issues.push(Issue::new(
+                format!("{path}.c13"),
+                format!(
+                    "{:e} Pa is invalid; it must satisfy |c13| ≤ {max:e} Pa",
+                    c.c13
+                ),
+            ));
+        } else if c.c11 > 0.0 && c.c33 > 0.0 && c.c11 * c.c33 - c.c13 * c.c13 <= 0.0 {
+            issues.push(Issue::new(
+                format!("{path}.c13"),
+                format!(
+                    "{:e} Pa is invalid; it must satisfy c13² < c11·c33 = {:e} Pa² (elastic stiffness positive definite)",
+                    c.c13,
+                    c.c11 * c.c33
+                ),
+            ));
+        }
+        for (name, value) in [("e31", c.e31), ("e33", c.e33), ("e15", c.e15)] {
+            if value.abs() > MAX_PIEZOELECTRIC {
+                issues.push(Issue::new(
+                    format!("{path}.{name}"),
+                    format!("{value:e} C/m² is invalid; it must satisfy |{name}| ≤ {MAX_PIEZOELECTRIC:e} C/m²"),
+                ));
+            }
+        }
+        for (name, value) in [("eps11", c.eps11), ("eps33", c.eps33)] {
+            if value <= 0.0 {
+                issues.push(Issue::new(
+                    format!("{path}.{name}"),
+                    format!("{value:e} C/(V·m) is invalid; it must be > 0 (permittivity positive definite)"),
+                ));
+            } else {
+                check_range(
+                    &mut issues,
+                    format!("{path}.{name}"),
+                    value,
+                    "C/(V·m)",
+                    PERMITTIVITY_RANGE,
+                );
             }
         }
         issues
+    }
+}
+
+impl Material {
+    /// Every problem with the constants, each naming the constant (`path` is prefixed). An
+    /// isotropic solid needs `μ` in [`STIFFNESS_RANGE`] and `−1 < ν ≤ 1/2`.
+    pub fn validate(&self, path: &str) -> Vec<Issue> {
+        match self {
+            Material::Piezoelectric(c) => c.validate(path),
+            Material::Elastic(c) => {
+                let mut issues = Vec::new();
+                check_range(
+                    &mut issues,
+                    format!("{path}.shear_modulus"),
+                    c.shear_modulus,
+                    "Pa",
+                    STIFFNESS_RANGE,
+                );
+                check_poisson(&mut issues, path, c.poisson_ratio);
+                issues
+            }
+        }
     }
 
     /// Scale the piezoelectric coupling constants by `factor` (used to study the uncoupled limit).
@@ -341,6 +423,68 @@ mod tests {
         });
         let paths: Vec<_> = iso.validate("m").into_iter().map(|i| i.path).collect();
         assert_eq!(paths, ["m.shear_modulus", "m.poisson_ratio"]);
+    }
+
+    #[test]
+    fn stiffness_outside_its_range_is_rejected() {
+        let tiny = Material::Piezoelectric(PiezoConstants {
+            c44: 2.56e-90,
+            ..PZT4
+        });
+        let issues = tiny.validate("material");
+        assert_eq!(issues.len(), 1);
+        assert_eq!(
+            issues[0].to_string(),
+            "`material.c44` = 2.56e-90 Pa is invalid; it must lie in [1e3, 1e14] Pa"
+        );
+        let c13 = Material::Piezoelectric(PiezoConstants { c13: -2e14, ..PZT4 });
+        assert_eq!(
+            c13.validate("m")[0].to_string(),
+            "`m.c13` = -2e14 Pa is invalid; it must satisfy |c13| ≤ 1e14 Pa"
+        );
+    }
+
+    #[test]
+    fn piezoelectric_constant_outside_its_range_is_rejected() {
+        let huge = Material::Piezoelectric(PiezoConstants {
+            e15: 1.27e301,
+            ..PZT4
+        });
+        assert_eq!(
+            huge.validate("material")[0].to_string(),
+            "`material.e15` = 1.27e301 C/m² is invalid; it must satisfy |e15| ≤ 1e3 C/m²"
+        );
+    }
+
+    #[test]
+    fn permittivity_outside_its_range_is_rejected() {
+        let huge = Material::Piezoelectric(PiezoConstants {
+            eps11: 1e308,
+            ..PZT4
+        });
+        assert_eq!(
+            huge.validate("material")[0].to_string(),
+            "`material.eps11` = 1e308 C/(V·m) is invalid; it must lie in [1e-14, 1e-3] C/(V·m)"
+        );
+    }
+
+    #[test]
+    fn isotropic_moduli_outside_their_range_are_rejected() {
+        let issues = validate_youngs("material", 1.0, 0.3);
+        assert_eq!(issues.len(), 1);
+        assert_eq!(
+            issues[0].to_string(),
+            "`material.youngs_modulus` = 1e0 Pa is invalid; it must lie in [1e3, 1e14] Pa"
+        );
+        assert!(validate_youngs("material", 70e9, 0.3).is_empty());
+        let stiff = Material::Elastic(IsotropicConstants {
+            shear_modulus: 1e20,
+            poisson_ratio: 0.3,
+        });
+        assert_eq!(
+            stiff.validate("material")[0].to_string(),
+            "`material.shear_modulus` = 1e20 Pa is invalid; it must lie in [1e3, 1e14] Pa"
+        );
     }
 
     #[test]

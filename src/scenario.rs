@@ -260,10 +260,11 @@ pub const DEFAULT_SCENARIO: &str = r#"{
   }
 }"#;
 
-/// Parse a scenario from JSON text; `path` names the source in messages.
+/// Parse a scenario from JSON text; `path` names the source in messages. Anything but
+/// whitespace after the JSON object is an error.
 pub fn parse(text: &str, path: &Path) -> Result<RawScenario, Error> {
     let de = &mut serde_json::Deserializer::from_str(text);
-    serde_path_to_error::deserialize(de).map_err(|e| {
+    let raw = serde_path_to_error::deserialize(&mut *de).map_err(|e| {
         let at = e.path().to_string();
         let inner = e.into_inner();
         Error::ParseScenario {
@@ -273,7 +274,15 @@ pub fn parse(text: &str, path: &Path) -> Result<RawScenario, Error> {
             column: inner.column(),
             message: inner.to_string(),
         }
-    })
+    })?;
+    de.end().map_err(|e| Error::ParseScenario {
+        path: path.to_path_buf(),
+        at: ".".to_string(),
+        line: e.line(),
+        column: e.column(),
+        message: format!("{e} (text after the scenario's JSON object)"),
+    })?;
+    Ok(raw)
 }
 
 /// Read, parse and validate a scenario file.
@@ -304,10 +313,127 @@ fn positive(issues: &mut Vec<Issue>, path: &str, value: f64, unit: &str) {
     }
 }
 
-/// Check every rule; return all problems at once.
+/// Most load steps in a run (the ramp to the first point, the lead-in, every repeat of the
+/// cycle), counted from the segments before anything is expanded.
+pub const MAX_LOAD_STEPS: usize = 500_000;
+/// Most collocation points M (`numerics.collocation_points`).
+pub const MAX_COLLOCATION_POINTS: usize = 1024;
+/// Most sample points per field file (`output.field_points`).
+pub const MAX_FIELD_POINTS: usize = 100_000;
+/// Most snapshot times (`output.snapshots`).
+pub const MAX_SNAPSHOTS: usize = 10_000;
+
+/// Check every rule; return all problems at once. Nothing whose size comes from the input
+/// (the repeated cycle, the load steps) is expanded before its size is checked.
 pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
     let mut issues = Vec::new();
-    let material = match &raw.material {
+    validate_name(&mut issues, &raw.name);
+    let material = resolve_material(&mut issues, &raw.material);
+    validate_loads(&mut issues, &raw);
+    validate_numerics(&mut issues, &raw.numerics);
+    let piezo = material.map(|m| m.is_piezoelectric());
+    let electrode = resolve_electrode(&mut issues, &raw.punch.electrode, piezo);
+    let history = raw
+        .tangential_history
+        .as_ref()
+        .map(|h| resolve_history(&mut issues, h, raw.friction, raw.normal_load));
+    let span = history.as_ref().and_then(|h| h.span);
+    let time_tolerance = validate_output(&mut issues, &raw.output, span, history.is_some());
+    match (material, electrode, issues.is_empty()) {
+        (Some(material), Some(electrode), true) => {
+            let history = history.and_then(|h| h.history);
+            build(raw, material, electrode, history, time_tolerance)
+        }
+        _ => Err(issues),
+    }
+}
+
+/// The validated scenario: the model, and the history with a point at every snapshot time.
+fn build(
+    raw: RawScenario,
+    material: Material,
+    electrode: Electrode,
+    history: Option<crate::history::LoadHistory>,
+    time_tolerance: f64,
+) -> Result<Scenario, Vec<Issue>> {
+    let model = ContactModel::try_new(material, raw.punch.radius, raw.friction, electrode)
+        .map_err(|failure| vec![material_issue(&raw.material, &failure)])?
+        .with_reference_distance(raw.reference_distance)
+        .with_coupling(raw.coupling)
+        .with_stick_end_kinks(raw.numerics.stick_end_kinks);
+    // Splitting a segment moves its steps, so repeat until every snapshot time is a step time
+    // (each time is added at most once).
+    let history = history.map(|mut h| {
+        while raw
+            .output
+            .snapshots
+            .iter()
+            .any(|&t| insert_snapshot_point(&mut h, t, time_tolerance))
+        {}
+        h
+    });
+    // Each added point can add up to `steps_per_segment` steps.
+    if let Some(n) = history.as_ref().map(load_step_count)
+        && n > MAX_LOAD_STEPS as f64
+    {
+        return Err(vec![Issue::new(
+            "output.snapshots",
+            format!(
+                "{} times off the step grid (each splits a segment) giving {} load steps is invalid; \
+                 it must give at most {MAX_LOAD_STEPS} load steps",
+                raw.output.snapshots.len(),
+                count_text(n)
+            ),
+        )]);
+    }
+    Ok(Scenario {
+        name: raw.name.clone(),
+        model,
+        normal_load: raw.normal_load,
+        collocation_points: raw.numerics.collocation_points,
+        history,
+        snapshots: raw.output.snapshots.clone(),
+        time_tolerance,
+        raw,
+    })
+}
+
+/// The name is a plain file name: it becomes the folder `output/<name>/`.
+fn validate_name(issues: &mut Vec<Issue>, name: &str) {
+    let plain = name
+        .chars()
+        .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
+    if !plain || name.is_empty() || name == "." || name == ".." {
+        issues.push(Issue::new(
+            "name",
+            format!(
+                "{name:?} is invalid; it must be a plain name of ASCII letters, digits, `-`, `_` and `.`, \
+                 not empty, `.` or `..` (it names the folder output/<name>)"
+            ),
+        ));
+    }
+}
+
+/// The issue for constants whose surface response cannot be computed.
+fn material_issue(raw: &RawMaterial, failure: &crate::error::MaterialFailure) -> Issue {
+    Issue::new(
+        material_path(raw),
+        format!(
+            "these constants are invalid; they must give a half-plane surface response ({failure})"
+        ),
+    )
+}
+
+fn material_path(raw: &RawMaterial) -> &'static str {
+    match raw {
+        RawMaterial::Preset { .. } => "material.name",
+        _ => "material",
+    }
+}
+
+/// The material: a preset, or constants in range with a computable surface response.
+fn resolve_material(issues: &mut Vec<Issue>, raw: &RawMaterial) -> Option<Material> {
+    let material = match raw {
         RawMaterial::Preset { name } => match preset(name) {
             Some(p) => Some(p.material),
             None => {
@@ -333,18 +459,12 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
                 poisson_ratio: *poisson_ratio,
             })),
             (None, Some(e)) => {
-                if !(e.is_finite() && *e > 0.0) {
-                    issues.push(Issue::new(
-                        "material.youngs_modulus",
-                        format!("{e} Pa is invalid; it must be finite and > 0"),
-                    ));
-                    None
-                } else {
-                    Some(Material::Elastic(IsotropicConstants::from_youngs(
-                        *e,
-                        *poisson_ratio,
-                    )))
-                }
+                // E and ν are the inputs: check them, not the derived μ.
+                let found = crate::material::validate_youngs("material", *e, *poisson_ratio);
+                let ok = found.is_empty();
+                issues.extend(found);
+                let m = IsotropicConstants::from_youngs(*e, *poisson_ratio);
+                return ok.then(|| surface_response(issues, raw, Material::Elastic(m)))?;
             }
             _ => {
                 issues.push(Issue::new(
@@ -354,44 +474,62 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
                 None
             }
         },
-    };
-    if let Some(m) = &material {
-        let prefix = match raw.material {
-            RawMaterial::Preset { .. } => "material.name",
-            _ => "material",
-        };
-        issues.extend(m.validate(prefix));
+    }?;
+    let found = material.validate(material_path(raw));
+    let ok = found.is_empty();
+    issues.extend(found);
+    ok.then(|| surface_response(issues, raw, material))?
+}
+
+/// `Some(material)` when its surface response can be computed, else an issue.
+fn surface_response(issues: &mut Vec<Issue>, raw: &RawMaterial, m: Material) -> Option<Material> {
+    match crate::halfplane::SurfaceCompliance::try_of(&m) {
+        Ok(_) => Some(m),
+        Err(failure) => {
+            issues.push(material_issue(raw, &failure));
+            None
+        }
     }
-    positive(&mut issues, "punch.radius", raw.punch.radius, "m");
-    positive(&mut issues, "normal_load", raw.normal_load, "N/m");
-    positive(
-        &mut issues,
-        "reference_distance",
-        raw.reference_distance,
-        "m",
-    );
+}
+
+/// Punch radius, loads, datum distance and friction.
+fn validate_loads(issues: &mut Vec<Issue>, raw: &RawScenario) {
+    positive(issues, "punch.radius", raw.punch.radius, "m");
+    positive(issues, "normal_load", raw.normal_load, "N/m");
+    positive(issues, "reference_distance", raw.reference_distance, "m");
     if !(raw.friction.is_finite() && raw.friction >= 0.0) {
         issues.push(Issue::new(
             "friction",
             format!("{} is invalid; it must be finite and ≥ 0", raw.friction),
         ));
     }
-    let m = raw.numerics.collocation_points;
-    let tol = raw.numerics.cycle_tolerance;
+}
+
+fn validate_numerics(issues: &mut Vec<Issue>, numerics: &RawNumerics) {
+    let m = numerics.collocation_points;
+    let tol = numerics.cycle_tolerance;
     if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
         issues.push(Issue::new(
             "numerics.cycle_tolerance",
             format!("{tol} is invalid; it must lie in (0, 1)"),
         ));
     }
-    if !(8..=1024).contains(&m) {
+    if !(8..=MAX_COLLOCATION_POINTS).contains(&m) {
         issues.push(Issue::new(
             "numerics.collocation_points",
-            format!("{m} is invalid; it must lie in [8, 1024]"),
+            format!("{m} is invalid; it must lie in [8, {MAX_COLLOCATION_POINTS}]"),
         ));
     }
-    let piezo = material.map(|m| m.is_piezoelectric());
-    let electrode = match (&raw.punch.electrode, piezo) {
+}
+
+/// The electrode, consistent with the material (`piezo` is `None` when the material is
+/// invalid).
+fn resolve_electrode(
+    issues: &mut Vec<Issue>,
+    raw: &RawElectrode,
+    piezo: Option<bool>,
+) -> Option<Electrode> {
+    match (raw, piezo) {
         (RawElectrode::None, Some(true)) => {
             issues.push(Issue::new(
                 "punch.electrode",
@@ -435,84 +573,210 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
             }
         },
         (RawElectrode::Insulating {}, _) => Some(Electrode::Insulating),
+    }
+}
+
+/// A history checked before it is expanded: the expanded history (`None` when it would be too
+/// long), and its time span.
+struct CheckedHistory {
+    history: Option<crate::history::LoadHistory>,
+    span: Option<(f64, f64)>,
+}
+
+/// Check a history's size from its segments, then expand and check it.
+fn resolve_history(
+    issues: &mut Vec<Issue>,
+    h: &RawHistory,
+    friction: f64,
+    normal_load: f64,
+) -> CheckedHistory {
+    let limit = friction * normal_load;
+    let scale = match h.unit {
+        LoadUnit::FractionOfLimit => limit,
+        LoadUnit::NewtonPerMetre => 1.0,
     };
-    let history = raw.tangential_history.as_ref().map(|h| {
-        let limit = raw.friction * raw.normal_load;
-        let scale = match h.unit {
-            LoadUnit::FractionOfLimit => limit,
-            LoadUnit::NewtonPerMetre => 1.0,
+    let max_step = h.max_step.map_or(0.05 * limit, |m| m * scale);
+    if friction <= 0.0 {
+        issues.push(Issue::new(
+            "tangential_history",
+            "a history is invalid without friction; it must have `friction` > 0",
+        ));
+    }
+    let sized = limit.is_finite() && limit > 0.0 && h.steps_per_segment > 0;
+    let steps = if sized && max_step.is_finite() && max_step > 0.0 {
+        h.load_steps(scale, max_step)
+    } else {
+        // Each segment takes at least one step.
+        h.point_count() - 1.0
+    };
+    if steps > MAX_LOAD_STEPS as f64 {
+        issues.push(Issue::new(
+            "tangential_history",
+            format!(
+                "{} load steps ({} points, {} cycle points × {} repeats, steps_per_segment = {}, \
+                 max_step = {max_step:e} N/m) is invalid; it must be at most {MAX_LOAD_STEPS}",
+                count_text(steps),
+                h.points.len(),
+                h.cycle.len(),
+                h.repeats,
+                h.steps_per_segment
+            ),
+        ));
+        validate_cycle(issues, &h.cycle);
+        return CheckedHistory {
+            history: None,
+            span: h.span(),
         };
-        let lead: Vec<(f64, f64)> = h.points.iter().map(|(t, q)| (*t, q * scale)).collect();
-        let cycle: Vec<(f64, f64)> = h.cycle.iter().map(|(t, q)| (*t, q * scale)).collect();
-        let points = crate::history::LoadHistory::with_cycles(
-            &lead,
-            &cycle,
-            if cycle.is_empty() { 0 } else { h.repeats },
-        );
-        let history = crate::history::LoadHistory {
-            points,
-            steps_per_segment: h.steps_per_segment,
-            max_step: h.max_step.map_or(0.05 * limit, |m| m * scale),
-        };
-        if raw.friction <= 0.0 {
+    }
+    let lead: Vec<(f64, f64)> = h.points.iter().map(|(t, q)| (*t, q * scale)).collect();
+    let cycle: Vec<(f64, f64)> = h.cycle.iter().map(|(t, q)| (*t, q * scale)).collect();
+    let repeats = if cycle.is_empty() { 0 } else { h.repeats };
+    let points = crate::history::LoadHistory::with_cycles(&lead, &cycle, repeats);
+    let history = crate::history::LoadHistory {
+        points,
+        steps_per_segment: h.steps_per_segment,
+        max_step,
+    };
+    if friction > 0.0 && limit.is_finite() && limit > 0.0 {
+        issues.extend(history.validate("tangential_history", limit));
+    }
+    validate_cycle(issues, &h.cycle);
+    let span = history
+        .points
+        .first()
+        .zip(history.points.last())
+        .map(|(a, b)| (a.0, b.0));
+    CheckedHistory {
+        history: Some(history),
+        span,
+    }
+}
+
+/// The cycle's times: strictly increasing and > 0.
+fn validate_cycle(issues: &mut Vec<Issue>, cycle: &[(f64, f64)]) {
+    for (i, w) in cycle.windows(2).enumerate() {
+        if w[1].0 <= w[0].0 {
             issues.push(Issue::new(
-                "tangential_history",
-                "a history is invalid without friction; it must have `friction` > 0",
+                format!("tangential_history.cycle[{}].t", i + 1),
+                format!(
+                    "{} s is invalid; it must be > previous Δt = {} s",
+                    w[1].0, w[0].0
+                ),
             ));
-        } else if limit.is_finite() && limit > 0.0 {
-            issues.extend(history.validate("tangential_history", limit));
         }
-        if !h.cycle.is_empty() {
-            for (i, w) in h.cycle.windows(2).enumerate() {
-                if w[1].0 <= w[0].0 {
-                    issues.push(Issue::new(
-                        format!("tangential_history.cycle[{}].t", i + 1),
-                        format!(
-                            "{} s is invalid; it must be > previous Δt = {} s",
-                            w[1].0, w[0].0
-                        ),
-                    ));
-                }
-            }
-            if h.cycle[0].0 <= 0.0 {
-                issues.push(Issue::new(
-                    "tangential_history.cycle[0].t",
-                    format!("{} s is invalid; it must be > 0", h.cycle[0].0),
-                ));
-            }
+    }
+    if let Some(first) = cycle.first()
+        && first.0 <= 0.0
+    {
+        issues.push(Issue::new(
+            "tangential_history.cycle[0].t",
+            format!("{} s is invalid; it must be > 0", first.0),
+        ));
+    }
+}
+
+/// A count held as f64: in full up to 1e12, else in exponent form.
+fn count_text(n: f64) -> String {
+    if n < 1e12 {
+        format!("{n:.0}")
+    } else {
+        format!("{n:.3e}")
+    }
+}
+
+/// Steps of a `(ΔQ)` segment, as [`crate::history::LoadHistory::steps`] cuts it.
+fn segment_steps(dq: f64, steps_per_segment: f64, max_step: f64) -> f64 {
+    if dq.abs() > 0.0 {
+        steps_per_segment.max((dq.abs() / max_step).ceil()).max(1.0)
+    } else {
+        1.0
+    }
+}
+
+/// Load steps of a run of an expanded history: the ramp to the first point and the segments.
+fn load_step_count(h: &crate::history::LoadHistory) -> f64 {
+    let sps = h.steps_per_segment as f64;
+    let ramp = h
+        .points
+        .first()
+        .map_or(0.0, |&(_, q)| ramp_steps(q, sps, h.max_step));
+    ramp + h
+        .points
+        .windows(2)
+        .map(|w| segment_steps(w[1].1 - w[0].1, sps, h.max_step))
+        .sum::<f64>()
+}
+
+/// Steps of the ramp from Q = 0 to the first point `q` (as `history::run_history` takes them).
+fn ramp_steps(q: f64, steps_per_segment: f64, max_step: f64) -> f64 {
+    if q.abs() > 0.0 {
+        steps_per_segment.max((q.abs() / max_step).ceil())
+    } else {
+        0.0
+    }
+}
+
+impl RawHistory {
+    /// Points after the cycle is repeated, counted without repeating it.
+    fn point_count(&self) -> f64 {
+        let repeats = if self.cycle.is_empty() {
+            0
+        } else {
+            self.repeats
+        };
+        self.points.len() as f64 + repeats as f64 * self.cycle.len() as f64
+    }
+
+    /// Load steps of a run (the ramp to the first point, the lead-in, each repeat of the
+    /// cycle), counted from the segments without repeating the cycle; `scale` turns Q into
+    /// N/m, `max_step` is in N/m.
+    fn load_steps(&self, scale: f64, max_step: f64) -> f64 {
+        let sps = self.steps_per_segment as f64;
+        let steps = |q0: f64, q1: f64| segment_steps(q1 * scale - q0 * scale, sps, max_step);
+        let within =
+            |pts: &[(f64, f64)]| pts.windows(2).map(|w| steps(w[0].1, w[1].1)).sum::<f64>();
+        let repeats = if self.cycle.is_empty() {
+            0.0
+        } else {
+            self.repeats as f64
+        };
+        let first = self
+            .points
+            .first()
+            .or(self.cycle.first().filter(|_| repeats > 0.0));
+        let mut total = first.map_or(0.0, |p| ramp_steps(p.1 * scale, sps, max_step));
+        total += within(&self.points);
+        if let (Some(c0), Some(c1)) = (self.cycle.first(), self.cycle.last())
+            && repeats > 0.0
+        {
+            let cycle = within(&self.cycle);
+            let join = self.points.last().map_or(0.0, |p| steps(p.1, c0.1));
+            total += join + cycle + (repeats - 1.0) * (steps(c1.1, c0.1) + cycle);
         }
-        history
-    });
-    let time_tolerance = validate_output(&mut issues, &raw.output, history.as_ref());
-    match (material, electrode, issues.is_empty()) {
-        (Some(material), Some(electrode), true) => {
-            let model = ContactModel::new(material, raw.punch.radius, raw.friction, electrode)
-                .with_reference_distance(raw.reference_distance)
-                .with_coupling(raw.coupling)
-                .with_stick_end_kinks(raw.numerics.stick_end_kinks);
-            // Splitting a segment moves its steps, so repeat until every snapshot time is a
-            // step time (each time is added at most once).
-            let history = history.map(|mut h| {
-                while raw
-                    .output
-                    .snapshots
-                    .iter()
-                    .any(|&t| insert_snapshot_point(&mut h, t, time_tolerance))
-                {}
-                h
-            });
-            Ok(Scenario {
-                name: raw.name.clone(),
-                model,
-                normal_load: raw.normal_load,
-                collocation_points: m,
-                history,
-                snapshots: raw.output.snapshots.clone(),
-                time_tolerance,
-                raw,
-            })
-        }
-        _ => Err(issues),
+        total
+    }
+
+    /// The time span `[first t, last t]` of the expanded history, computed without expanding
+    /// it (to round-off: for checks of a history too long to expand).
+    fn span(&self) -> Option<(f64, f64)> {
+        let repeats = if self.cycle.is_empty() {
+            0.0
+        } else {
+            self.repeats as f64
+        };
+        let t_lead = self.points.last().map_or(0.0, |p| p.0);
+        let first = self.points.first().map(|p| p.0).or_else(|| {
+            self.cycle
+                .first()
+                .filter(|_| repeats > 0.0)
+                .map(|c| t_lead + c.0)
+        })?;
+        let last = self
+            .cycle
+            .last()
+            .filter(|_| repeats > 0.0)
+            .map_or(t_lead, |c| t_lead + repeats * c.0);
+        Some((first, last))
     }
 }
 
@@ -527,20 +791,30 @@ pub fn snapshot_stem(t: f64) -> String {
 fn validate_output(
     issues: &mut Vec<Issue>,
     out: &RawOutput,
-    history: Option<&crate::history::LoadHistory>,
+    span: Option<(f64, f64)>,
+    has_history: bool,
 ) -> f64 {
     let n = out.field_points;
-    if !(16..=100_000).contains(&n) || !n.is_multiple_of(4) {
+    if !(16..=MAX_FIELD_POINTS).contains(&n) || !n.is_multiple_of(4) {
         issues.push(Issue::new(
             "output.field_points",
             format!(
-                "{n} is invalid; it must be a multiple of 4 in [16, 100000] (so that no sample falls on a contact end)"
+                "{n} is invalid; it must be a multiple of 4 in [16, {MAX_FIELD_POINTS}] (so that no sample falls on a contact end)"
             ),
         ));
     }
-    let span = history.and_then(|h| Some((h.points.first()?.0, h.points.last()?.0)));
+    if out.snapshots.len() > MAX_SNAPSHOTS {
+        issues.push(Issue::new(
+            "output.snapshots",
+            format!(
+                "{} times is invalid; it must hold at most {MAX_SNAPSHOTS}",
+                out.snapshots.len()
+            ),
+        ));
+        return 0.0;
+    }
     let Some((t0, t1)) = span.filter(|(a, b)| a.is_finite() && b.is_finite()) else {
-        if history.is_none() && !out.snapshots.is_empty() {
+        if !has_history && !out.snapshots.is_empty() {
             issues.push(Issue::new(
                 "output.snapshots",
                 "a list of times is invalid without a `tangential_history`; it must be [] or omitted \
@@ -708,6 +982,72 @@ mod tests {
     }
 
     #[test]
+    fn text_after_the_object_is_rejected_with_line_and_column() {
+        let text = format!("{DEFAULT_SCENARIO}\n{{}}");
+        match check(&text) {
+            Err(e @ Error::ParseScenario { line, column, .. }) => {
+                assert_eq!((line, column), (14, 1));
+                assert_eq!(
+                    e.to_string(),
+                    "t.json: invalid scenario at `.` (line 14, column 1): trailing characters at line 14 column 1 \
+                     (text after the scenario's JSON object)"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(check(&format!("{DEFAULT_SCENARIO}\n \n")).is_ok());
+    }
+
+    #[test]
+    fn name_must_be_a_plain_name() {
+        for bad in ["../evil", "a/b", "", ".", "..", "a b", "c:\\x"] {
+            let text = DEFAULT_SCENARIO.replace("\"baseline\"", &format!("{bad:?}"));
+            let found = issues(&text);
+            assert_eq!(found[0].path, "name", "{bad}");
+        }
+        let text = DEFAULT_SCENARIO.replace("\"baseline\"", "\"../evil\"");
+        assert_eq!(
+            issues(&text)[0].to_string(),
+            "`name` = \"../evil\" is invalid; it must be a plain name of ASCII letters, digits, `-`, `_` and `.`, \
+             not empty, `.` or `..` (it names the folder output/<name>)"
+        );
+        let text = DEFAULT_SCENARIO.replace("\"baseline\"", "\"run-2_b.v1\"");
+        assert!(check(&text).is_ok());
+    }
+
+    #[test]
+    fn collocation_points_are_limited() {
+        let text = DEFAULT_SCENARIO.replacen(
+            "\"friction\": 0.3,",
+            "\"friction\": 0.3, \"numerics\": {\"collocation_points\": 1025},",
+            1,
+        );
+        assert_eq!(
+            issues(&text)[0].to_string(),
+            "`numerics.collocation_points` = 1025 is invalid; it must lie in [8, 1024]"
+        );
+    }
+
+    #[test]
+    fn stroh_failure_is_an_issue_at_the_material() {
+        let failure =
+            crate::halfplane::SurfaceCompliance::try_of(&Material::Piezoelectric(PiezoConstants {
+                c44: 2.56e-90,
+                ..crate::material::PZT4
+            }))
+            .unwrap_err();
+        let raw = RawMaterial::Piezoelectric(crate::material::PZT4);
+        let issue = material_issue(&raw, &failure);
+        assert_eq!(issue.path, "material");
+        assert!(
+            issue.message.starts_with(
+                "these constants are invalid; they must give a half-plane surface response ("
+            ),
+            "{issue}"
+        );
+    }
+
+    #[test]
     fn conducting_needs_exactly_one_electric_load() {
         let text =
             DEFAULT_SCENARIO.replace("\"charge\": 6e-7", "\"charge\": 6e-7, \"potential\": 1.0");
@@ -818,6 +1158,48 @@ mod history_tests {
         assert!((s.time_tolerance - 1.3e-8).abs() < 1e-20);
         assert_eq!(snapshot_stem(-0.0), "t_0.000000");
         assert_eq!(snapshot_stem(2.5), "t_2.500000");
+    }
+
+    #[test]
+    fn load_steps_are_counted_and_limited_before_expanding() {
+        // The default history: ramp 0, lead-in 10, then 3 × (20 + 20) steps (max step 30 N/m
+        // over 300 N/m and 10 per segment): 130 steps.
+        let s = default_scenario();
+        let h = s.history.as_ref().unwrap();
+        assert_eq!(load_step_count(h) as usize, 130);
+        let raw = s.raw.tangential_history.as_ref().unwrap();
+        assert_eq!(raw.load_steps(600.0, h.max_step) as usize, 130);
+        let text = DEFAULT_SCENARIO.replace("\"repeats\": 3", "\"repeats\": 1000000000000000000");
+        let found = issues_of(&text);
+        assert_eq!(found.len(), 1);
+        assert_eq!(
+            found[0].to_string(),
+            "`tangential_history` = 4.000e19 load steps (2 points, 2 cycle points × 1000000000000000000 repeats, \
+             steps_per_segment = 10, max_step = 3e1 N/m) is invalid; it must be at most 500000"
+        );
+        let just = DEFAULT_SCENARIO.replace("\"repeats\": 3", "\"repeats\": 12499");
+        assert!(validate(parse(&just, Path::new("t.json")).unwrap()).is_ok());
+        let over = DEFAULT_SCENARIO.replace("\"repeats\": 3", "\"repeats\": 12500");
+        assert!(issues_of(&over)[0].message.starts_with("500010 load steps"));
+        let tiny =
+            DEFAULT_SCENARIO.replace("\"repeats\": 3", "\"repeats\": 3, \"max_step\": 1e-300");
+        assert_eq!(issues_of(&tiny)[0].path, "tangential_history");
+    }
+
+    #[test]
+    fn snapshots_are_limited() {
+        let times: Vec<String> = (0..=MAX_SNAPSHOTS)
+            .map(|i| format!("{}", i as f64 * 1e-3))
+            .collect();
+        let found = issues_of(&with_output(&format!(
+            "{{\"snapshots\": [{}]}}",
+            times.join(", ")
+        )));
+        assert_eq!(found.len(), 1);
+        assert_eq!(
+            found[0].to_string(),
+            "`output.snapshots` = 10001 times is invalid; it must hold at most 10000"
+        );
     }
 
     #[test]

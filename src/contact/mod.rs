@@ -63,6 +63,7 @@ pub mod tangential;
 
 use serde::Serialize;
 
+use crate::error::MaterialFailure;
 use crate::halfplane::{SurfaceCompliance, SurfaceFieldCoefficients};
 use crate::material::Material;
 use crate::quadrature::{BoundedSeries, UnboundedSeries};
@@ -133,10 +134,16 @@ pub struct ChargeSplit {
 }
 
 impl ContactModel {
-    /// A model with the coefficients derived from `material`.
-    pub fn new(material: Material, radius: f64, friction: f64, electrode: Electrode) -> Self {
-        Self {
-            compliance: SurfaceCompliance::of(&material),
+    /// A model with the coefficients derived from `material`, or why the constants give no
+    /// surface response ([`SurfaceCompliance::try_of`]).
+    pub fn try_new(
+        material: Material,
+        radius: f64,
+        friction: f64,
+        electrode: Electrode,
+    ) -> Result<Self, MaterialFailure> {
+        Ok(Self {
+            compliance: SurfaceCompliance::try_of(&material)?,
             field_coefficients: SurfaceFieldCoefficients::of(&material),
             material,
             radius,
@@ -145,7 +152,17 @@ impl ContactModel {
             reference_distance: 1e-2,
             coupling: Coupling::Full,
             stick_end_kinks: true,
-        }
+        })
+    }
+
+    /// A model with the coefficients derived from a material known to be sound (the presets,
+    /// tests).
+    ///
+    /// # Panics
+    /// If [`Self::try_new`] fails; use that on constants from the user.
+    pub fn new(material: Material, radius: f64, friction: f64, electrode: Electrode) -> Self {
+        Self::try_new(material, radius, friction, electrode)
+            .unwrap_or_else(|e| panic!("contact model: {e}"))
     }
 
     /// With the kinks at the stick ends on or off.
