@@ -272,7 +272,7 @@ pub fn parse(text: &str, path: &Path) -> Result<RawScenario, Error> {
             at,
             line: inner.line(),
             column: inner.column(),
-            message: inner.to_string(),
+            message: plain_message(&inner),
         }
     })?;
     de.end().map_err(|e| Error::ParseScenario {
@@ -280,9 +280,58 @@ pub fn parse(text: &str, path: &Path) -> Result<RawScenario, Error> {
         at: ".".to_string(),
         line: e.line(),
         column: e.column(),
-        message: format!("{e} (text after the scenario's JSON object)"),
+        message: format!(
+            "{} (text after the scenario's JSON object)",
+            plain_message(&e)
+        ),
     })?;
     Ok(raw)
+}
+
+/// The parser's message in the words of the scenario format: without its position (the error
+/// gives line and column) and without Rust's type names (`f64` is a number, `struct RawPunch`
+/// an object).
+fn plain_message(e: &serde_json::Error) -> String {
+    let text = e.to_string();
+    let text = match text.rsplit_once(" at line ") {
+        Some((message, _)) if e.line() > 0 => message.to_string(),
+        _ => text,
+    };
+    let mut words: Vec<String> = Vec::new();
+    let mut tokens = text.split(' ').peekable();
+    while let Some(token) = tokens.next() {
+        let (core, tail) = match token.find(|c: char| !c.is_alphanumeric() && c != '_') {
+            Some(i) => token.split_at(i),
+            None => (token, ""),
+        };
+        let plain = match core {
+            "f64" | "f32" => Some("a number"),
+            "u8" | "u16" | "u32" | "u64" | "usize" => Some("a whole number ≥ 0"),
+            "i8" | "i16" | "i32" | "i64" | "isize" => Some("a whole number"),
+            "struct" | "enum" if tokens.peek().is_some() => {
+                // `struct RawPunch`, `internally tagged enum RawMaterial`
+                let next = tokens.next().unwrap_or_default();
+                let (_, tail) = next.split_at(next.find([',', ')']).unwrap_or(next.len()));
+                words.push(format!(
+                    "{}{tail}",
+                    if core == "struct" {
+                        "an object"
+                    } else {
+                        "an object with a `kind`"
+                    }
+                ));
+                continue;
+            }
+            _ => None,
+        };
+        match plain {
+            Some(p) => words.push(format!("{p}{tail}")),
+            None => words.push(token.to_string()),
+        }
+    }
+    words
+        .join(" ")
+        .replace("internally tagged an object", "an object")
 }
 
 /// Read, parse and validate a scenario file.
@@ -892,6 +941,39 @@ fn insert_snapshot_point(history: &mut crate::history::LoadHistory, t: f64, tol:
 
 #[cfg(test)]
 mod tests {
+    /// Type errors read in the format's words: no Rust type names, no repeated position.
+    #[test]
+    fn parse_messages_show_no_rust_type_names() {
+        let base: serde_json::Value = serde_json::from_str(DEFAULT_SCENARIO).unwrap();
+        let cases = [
+            ("friction", serde_json::json!("x"), "expected a number"),
+            ("punch", serde_json::json!(3), "expected an object"),
+            (
+                "material",
+                serde_json::json!("pzt4"),
+                "expected an object with a `kind`",
+            ),
+            (
+                "numerics",
+                serde_json::json!({"collocation_points": -3}),
+                "expected a whole number ≥ 0",
+            ),
+        ];
+        for (field, value, expected) in cases {
+            let mut v = base.clone();
+            v[field] = value;
+            let text = serde_json::to_string_pretty(&v).unwrap();
+            let message = match parse(&text, Path::new("s.json")) {
+                Err(e) => e.to_string(),
+                Ok(_) => panic!("{field}: parsed"),
+            };
+            assert!(message.contains(expected), "{field}: {message}");
+            for rust in ["f64", "usize", "u64", "struct", "enum", "Raw", " at line "] {
+                assert!(!message.contains(rust), "{field}: {message}");
+            }
+        }
+    }
+
     use super::*;
 
     fn check(text: &str) -> Result<Scenario, Error> {
