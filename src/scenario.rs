@@ -1071,7 +1071,7 @@ mod tests {
                 assert_eq!((line, column), (14, 1));
                 assert_eq!(
                     e.to_string(),
-                    "t.json: invalid scenario at `.` (line 14, column 1): trailing characters at line 14 column 1 \
+                    "t.json: invalid scenario at `.` (line 14, column 1): trailing characters \
                      (text after the scenario's JSON object)"
                 );
             }
