@@ -36,13 +36,13 @@ pub enum Command {
         scenario: PathBuf,
         /// `FIELD=START:END:COUNT` (repeatable; the Cartesian product is run).
         #[arg(long, required = true)]
-        vary: Vec<crate::app::Vary>,
+        vary: Vec<crate::io::Vary>,
         /// Output folder (default: `output/<scenario name>-sweep`).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Run only every N-th variant starting at I (`I/N`), for array jobs.
         #[arg(long)]
-        shard: Option<crate::app::Shard>,
+        shard: Option<crate::io::Shard>,
         /// Run each variant's whole scenario (history, snapshots, plots) into
         /// `OUT/variant_NNNN/`, and write comparison plots `OUT/plots/compare_*.svg` (not with
         /// `--shard`).

@@ -27,15 +27,15 @@
 //!
 //! ## Use as a library
 //! [`scenario::parse`] and [`scenario::validate`] (or [`scenario::load`] for a file) give a
-//! [`scenario::Scenario`]; [`app::solve`] solves it and writes nothing; [`app::run`] also
+//! [`scenario::Scenario`]; [`io::solve`] solves it and writes nothing; [`io::run()`] also
 //! writes the output folder that `fretsim run` writes.
 //!
 //! ```
-//! use fretsim::{app, history::NoObserver, scenario};
+//! use fretsim::{history::NoObserver, io, scenario};
 //!
 //! // The built-in scenario: PZT-4, conducting punch, P = 2000 N/m, three cycles of ±0.5 ηP.
 //! let scenario = scenario::default_scenario();
-//! let solution = app::solve(&scenario, &mut NoObserver).expect("the default scenario solves");
+//! let solution = io::solve(&scenario, &mut NoObserver).expect("the default scenario solves");
 //! let normal = &solution.summary.normal_loading;
 //! assert!((normal.pressure_resultant - 2000.0).abs() < 1e-6); // ∫p dx = P
 //! assert!(normal.stick_ratio > 0.0 && normal.stick_ratio < 1.0); // slip zones at both ends
@@ -66,21 +66,21 @@
 //!   [`contact::normal`] (Spence's self-similar partial slip), [`contact::pressure`] (shared
 //!   pressure and charge sub-problems).
 //! - [`analytical`]: closed-form oracles.
-//! - [`scenario`], [`app`], [`output`], [`cli`], [`error`]: input, orchestration, files, arguments,
+//! - [`analysis`]: the cycles of a history, the energy per cycle and the verdict.
+//! - [`scenario`], [`io`], [`cli`], [`error`]: input, solving and writing a run or a sweep, arguments,
 //!   errors. The numerical modules do no I/O.
 #![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod analysis;
 pub mod analytical;
-pub mod app;
 pub mod cli;
 pub mod contact;
 pub mod error;
 pub mod halfplane;
 pub mod history;
+pub mod io;
 pub mod material;
-pub mod output;
-pub mod plot;
 pub mod quadrature;
 pub mod scenario;
 pub mod transforms;

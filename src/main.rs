@@ -7,7 +7,8 @@ use std::process::ExitCode;
 use clap::Parser;
 use fretsim::cli::{Cli, Command};
 use fretsim::error::Error;
-use fretsim::{app, material, output, scenario};
+use fretsim::io::{self, folder};
+use fretsim::{material, scenario};
 
 /// mimalloc instead of the system allocator: the solver makes many small allocations per step
 /// (the per-evaluation point lists, maps and batches). Built without transparent huge pages
@@ -83,7 +84,7 @@ fn dispatch(command: Command) -> Result<(), Error> {
             &scenario,
             &vary,
             out,
-            app::SweepOptions { shard, runs },
+            io::SweepOptions { shard, runs },
             quiet,
         ),
         Command::Check { scenario: path } => {
@@ -103,10 +104,10 @@ fn run(path: Option<PathBuf>, out: Option<PathBuf>, quiet: bool) -> Result<(), E
         None => scenario::default_scenario(),
     };
     let out = out.unwrap_or_else(|| PathBuf::from("output").join(&sc.name));
-    let folder = output::RunFolder::claim(&out, &output::Protected::new(path.as_deref()))?;
+    let folder = folder::RunFolder::claim(&out, &folder::Protected::new(path.as_deref()))?;
     let total = sc.history.as_ref().map_or(0, |h| h.steps().len() as u64);
     let mut progress = Progress::new(total, quiet);
-    let result = app::run_with(&sc, folder, &mut progress);
+    let result = io::run_with(&sc, folder, &mut progress);
     progress.finish();
     let result = match result {
         Ok(result) => result,
@@ -139,9 +140,9 @@ fn run(path: Option<PathBuf>, out: Option<PathBuf>, quiet: bool) -> Result<(), E
 /// `fretsim sweep`: exits 1 when any variant failed.
 fn sweep(
     path: &Path,
-    vary: &[app::Vary],
+    vary: &[io::Vary],
     out: Option<PathBuf>,
-    options: app::SweepOptions,
+    options: io::SweepOptions,
     quiet: bool,
 ) -> Result<(), Error> {
     let sc = scenario::load(path)?;
@@ -166,8 +167,8 @@ fn sweep(
             b.set_position(n);
         }
     };
-    let protected = output::Protected::new(Some(path));
-    let result = app::sweep(&text, path, vary, options, &out, &protected, &on_variant);
+    let protected = folder::Protected::new(Some(path));
+    let result = io::sweep(&text, path, vary, options, &out, &protected, &on_variant);
     progress.finish();
     let result = result?;
     println!(
@@ -215,7 +216,7 @@ fn materials(name: Option<String>, json: bool) -> Result<(), Error> {
                 );
                 serde_json::json!({
                     "name": p.name, "source": p.source, "material": p.material,
-                    "derived": app::derived(&model, 1.0),
+                    "derived": io::summary::derived(&model, 1.0),
                 })
             })
             .collect();

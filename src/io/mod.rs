@@ -1,0 +1,23 @@
+//! The input/output layer on top of the numerical core: solving a scenario and writing what a
+//! run and a sweep produce. The numerical modules (`halfplane`, `quadrature`, `contact`,
+//! `history`, `analysis`) do no I/O; everything that touches the file system is here, in
+//! `scenario` (reading) and in the command (`main.rs`).
+//!
+//! - [`mod@run`]: [`solve`] (a scenario's results, nothing written) and [`run()`] (solve, then write
+//!   the output folder);
+//! - [`summary`]: the contents of `summary.json`;
+//! - [`csv`], [`plots`], [`svg`]: the files of a run;
+//! - [`mod@sweep`]: `fretsim sweep`;
+//! - [`folder`]: the output folder's rules: never touch what fretsim did not write, replace a
+//!   previous output atomically.
+
+pub mod csv;
+pub mod folder;
+pub mod plots;
+pub mod run;
+pub mod summary;
+pub mod svg;
+pub mod sweep;
+
+pub use run::{RunResult, Solution, run, run_with, solve};
+pub use sweep::{Shard, SweepOptions, SweepOutput, Vary, sweep};

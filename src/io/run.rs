@@ -1,0 +1,408 @@
+//! One run of a scenario: [`solve`] computes everything and writes nothing; [`run`] also writes
+//! the output folder that `fretsim run` writes (claimed before the solve, swapped in at the end).
+
+use std::path::{Path, PathBuf};
+
+use crate::analysis::{CycleRow, analyse_cycles};
+use crate::contact::SurfacePoint;
+use crate::contact::normal::{NormalOptions, solve_normal};
+use crate::contact::pressure::Discretisation;
+use crate::contact::tangential::SlipOptions;
+use crate::error::Error;
+use crate::io::csv::{cycles_csv, fields_csv, steps_csv};
+use crate::io::folder::{Protected, RunFolder};
+use crate::io::plots::{family_plots, history_plots, index_html, normal_loading_plots};
+use crate::io::summary::{
+    HistorySummary, Resolved, SnapshotSummary, Summary, derived, normal_summary, solver_statistics,
+};
+use crate::scenario::Scenario;
+
+/// What a run produced.
+#[derive(Debug)]
+pub struct RunResult {
+    /// Output folder.
+    pub out_dir: PathBuf,
+    /// Summary (as written).
+    pub summary: Summary,
+    /// The sampled fields: the end of normal loading, then one set per snapshot time.
+    pub fields: Vec<FieldSet>,
+}
+
+/// Everything a run computes, before anything is written: what [`solve`] returns and what
+/// the output files are made of.
+#[derive(Debug)]
+pub struct Solution {
+    /// The summary (`summary.json`).
+    pub summary: Summary,
+    /// The sampled fields: the end of normal loading, then one set per snapshot time reached.
+    pub fields: Vec<FieldSet>,
+    /// The fields at the turning points and the last step (empty when
+    /// `output.turning_point_fields` is off).
+    pub turning_fields: Vec<FieldSet>,
+    /// One record per accepted step (step 0 is the end of normal loading).
+    pub records: Vec<crate::history::StepRecord>,
+    /// The cycles of the history.
+    pub cycles: Vec<CycleRow>,
+    /// The solver failure that stopped the history part-way, if any.
+    pub failure: Option<Error>,
+}
+
+/// Sample points for field output: the contact and a margin of one half-width each side,
+/// never exactly at the contact ends (where g and Dx0 are singular for a conducting punch).
+pub fn field_points(centre: f64, half_width: f64, count: usize) -> Vec<f64> {
+    (0..count)
+        .map(|i| centre + 2.0 * half_width * ((2 * i + 1) as f64 - count as f64) / count as f64)
+        .collect()
+}
+
+/// Solve a validated scenario and write its outputs into `out_dir`, which must be new or a
+/// previous fretsim output ([`RunFolder::claim`]).
+pub fn run(scenario: &Scenario, out_dir: &Path) -> Result<RunResult, Error> {
+    let folder = RunFolder::claim(out_dir, &Protected::new(None))?;
+    run_with(scenario, folder, &mut crate::history::NoObserver)
+}
+
+/// Sampled surface fields of one instant: a field file and a curve of the plots.
+#[derive(Debug, Clone)]
+pub struct FieldSet {
+    /// File stem under `fields/` (`normal_loading`, `t_2.000000`).
+    pub stem: String,
+    /// Legend label.
+    pub label: String,
+    /// The samples.
+    pub points: Vec<SurfacePoint>,
+}
+
+/// Keeps, while the history runs, the states that the field files need: the turning points
+/// (the last step of each phase), the last step, and the steps at the snapshot times.
+pub(crate) struct Snapshots<'a> {
+    inner: &'a mut dyn crate::history::Observer,
+    previous: Option<(crate::history::StepRecord, crate::contact::ContactState)>,
+    kept: Vec<(crate::history::StepRecord, crate::contact::ContactState)>,
+    times: &'a [f64],
+    tolerance: f64,
+    at_times: Vec<Option<(crate::history::StepRecord, crate::contact::ContactState)>>,
+}
+
+impl crate::history::Observer for Snapshots<'_> {
+    fn on_step(
+        &mut self,
+        record: &crate::history::StepRecord,
+        state: &crate::contact::ContactState,
+    ) {
+        if let Some((prev, prev_state)) = self.previous.take()
+            && prev.phase != record.phase
+            && prev.phase > 0
+        {
+            self.kept.push((prev, prev_state));
+        }
+        self.previous = Some((record.clone(), state.clone()));
+        // The last step at a snapshot time wins (a ramp to a non-zero first point is solved
+        // in several steps at the same time).
+        for (t, slot) in self.times.iter().zip(self.at_times.iter_mut()) {
+            if (record.t - t).abs() <= self.tolerance {
+                *slot = Some((record.clone(), state.clone()));
+            }
+        }
+        self.inner.on_step(record, state);
+    }
+
+    fn on_phase(&mut self, phase: usize, memory: &crate::contact::memory::Memory) {
+        self.inner.on_phase(phase, memory);
+    }
+}
+
+/// As [`run`], reporting each accepted step to `observer` (progress bars).
+pub fn run_with(
+    scenario: &Scenario,
+    folder: RunFolder,
+    observer: &mut dyn crate::history::Observer,
+) -> Result<RunResult, Error> {
+    match run_partial(scenario, folder, observer)? {
+        (result, None) => Ok(result),
+        (_, Some(failure)) => Err(failure),
+    }
+}
+
+/// As [`run_with`], but a solver failure during the history is returned beside what was
+/// written (the summary and the fields reached) instead of replacing it. A failure of the
+/// normal loading is returned as `Err` after `failure.json` is written; so is a write error.
+pub fn run_partial(
+    scenario: &Scenario,
+    mut folder: RunFolder,
+    observer: &mut dyn crate::history::Observer,
+) -> Result<(RunResult, Option<Error>), Error> {
+    crate::io::folder::pause_point("solve");
+    match solve(scenario, observer) {
+        Ok(mut solution) => {
+            let out_dir = write_solution(folder, scenario, &solution)?;
+            let failure = solution.failure.take();
+            Ok((
+                RunResult {
+                    out_dir,
+                    summary: solution.summary,
+                    fields: solution.fields,
+                },
+                failure,
+            ))
+        }
+        Err(error) => {
+            folder.write("failure.json", &failure_json(&error, None))?;
+            folder.commit()?;
+            Err(error)
+        }
+    }
+}
+
+/// Solve a validated scenario: the normal loading, then the tangential history if any, and
+/// the fields and the summary made from them. Writes nothing. A failure of the normal loading
+/// is an `Err`; a failure part-way through the history is returned in
+/// [`Solution::failure`] beside the steps solved before it.
+pub fn solve(
+    scenario: &Scenario,
+    observer: &mut dyn crate::history::Observer,
+) -> Result<Solution, Error> {
+    let model = &scenario.model;
+    let disc = Discretisation::new(scenario.collocation_points);
+    let normal = solve_normal(model, &disc, scenario.normal_load, NormalOptions::default())
+        .map_err(|failure| Error::Solve {
+            context: "normal loading".into(),
+            failure,
+        })?;
+    let mut warnings = Vec::new();
+    let gamma1 = model.pressure_charge(scenario.normal_load);
+    let gap = model.outside_gap(&normal.state);
+    if gap.min_gap < 0.0 {
+        warnings.push(format!(
+            "the surface interpenetrates the punch just outside the contact: gap {:.3e} m at x = {:.4e} m \
+             (a²/2R = {:.3e} m); Γ = {:.4e} C/m exceeds the charge carried by the pressure Γ1 = kP = {gamma1:.4e} C/m, \
+             and the conducting-punch model (smooth pressure at the contact ends) then admits no state with a non-negative gap",
+            gap.min_gap, gap.at, gap.scale, normal.state.charge
+        ));
+    }
+    // The tangential history, if any; a failure keeps the steps already solved.
+    let mut records = Vec::new();
+    let mut failure = None;
+    let mut snapshots = Snapshots {
+        inner: observer,
+        previous: None,
+        kept: Vec::new(),
+        times: &scenario.snapshots,
+        tolerance: scenario.time_tolerance,
+        at_times: vec![None; scenario.snapshots.len()],
+    };
+    if let Some(history) = &scenario.history {
+        match crate::history::run_history(
+            model,
+            &disc,
+            &normal,
+            history,
+            SlipOptions::default(),
+            &mut snapshots,
+        ) {
+            Ok(run) => records = run.records,
+            Err(f) => {
+                let f = *f;
+                records = f.records;
+                failure = Some(Error::Solve {
+                    context: f.failure.to_string(),
+                    failure: f.failure.failure,
+                });
+            }
+        }
+    }
+    let solver_tolerance = SlipOptions::default().tolerance;
+    let stalled: Vec<&crate::history::StepRecord> = records
+        .iter()
+        .filter(|r| r.residual >= solver_tolerance)
+        .collect();
+    if let Some(worst) = stalled
+        .iter()
+        .max_by(|x, y| x.residual.total_cmp(&y.residual))
+    {
+        warnings.push(format!(
+            "{} step(s) accepted with a stalled residual above the solver tolerance {solver_tolerance:e} \
+             (largest {:.3e} at step {}, t = {} s): the iteration stopped improving below the \
+             stall tolerance; see the residual column of steps.csv",
+            stalled.len(),
+            worst.residual,
+            worst.step,
+            worst.t
+        ));
+    }
+    let limit = model.friction * scenario.normal_load;
+    let tolerance = scenario.raw.numerics.cycle_tolerance;
+    let (cycles, verdict) = analyse_cycles(&records, tolerance);
+    let history_summary = scenario.history.as_ref().map(|_| {
+        let turning_points = records
+            .windows(2)
+            .filter(|w| w[0].phase != w[1].phase && w[0].phase > 0)
+            .map(|w| w[0].clone())
+            .chain(records.last().filter(|r| r.phase > 0).cloned())
+            .collect();
+        HistorySummary {
+            steps: records.len().saturating_sub(1),
+            phases: records.last().map_or(0, |r| r.phase),
+            turning_points,
+            failure: failure.as_ref().map(|e| e.to_string()),
+            cycles: cycles.clone(),
+            verdict,
+            verdict_tolerance: tolerance,
+        }
+    });
+    // Sampled fields: the end of normal loading, then each snapshot time reached.
+    let n = scenario.raw.output.field_points;
+    let sample = |state: &crate::contact::ContactState| -> Vec<SurfacePoint> {
+        field_points(state.centre, state.half_width, n)
+            .into_iter()
+            .map(|x| model.surface_point(state, x))
+            .collect()
+    };
+    let mut fields = vec![FieldSet {
+        stem: "normal_loading".into(),
+        label: "end of normal loading".into(),
+        points: sample(&normal.state),
+    }];
+    let mut snapshot_rows = Vec::new();
+    for (&t, kept) in scenario.snapshots.iter().zip(&snapshots.at_times) {
+        let stem = crate::scenario::snapshot_stem(t);
+        match kept {
+            Some((rec, state)) => {
+                fields.push(FieldSet {
+                    label: format!("t = {t} s, Q/(ηP) = {:.3}", rec.q / limit),
+                    stem: stem.clone(),
+                    points: sample(state),
+                });
+                snapshot_rows.push(SnapshotSummary {
+                    t,
+                    file: format!("fields/{stem}.csv"),
+                    step: rec.step,
+                    step_t: rec.t,
+                    q: rec.q,
+                    q_over_limit: rec.q / limit,
+                    regime: rec.regime,
+                    phase: rec.phase,
+                    half_width: rec.half_width,
+                    eccentricity: rec.eccentricity,
+                    stick_lo: rec.stick_lo,
+                    stick_hi: rec.stick_hi,
+                });
+            }
+            None => warnings.push(format!(
+                "snapshot t = {t} s was not reached (the history stopped at t = {} s); fields/{stem}.csv is not written",
+                records.last().map_or(f64::NAN, |r| r.t)
+            )),
+        }
+    }
+    let summary = Summary {
+        fretsim_version: env!("CARGO_PKG_VERSION"),
+        scenario: scenario.raw.clone(),
+        resolved: Resolved {
+            material: model.material,
+            load_history: scenario.history.clone(),
+        },
+        derived: derived(model, scenario.normal_load),
+        normal_loading: normal_summary(model, &normal),
+        history: history_summary,
+        snapshots: snapshot_rows,
+        solver: solver_statistics(scenario, &normal, &records),
+        warnings,
+    };
+    // Turning points and the last step, unless switched off.
+    let mut turning_fields = Vec::new();
+    if scenario.raw.output.turning_point_fields {
+        for (rec, state) in snapshots.kept.iter().chain(snapshots.previous.iter()) {
+            turning_fields.push(FieldSet {
+                stem: format!("step_{:05}", rec.step),
+                label: format!("step {}", rec.step),
+                points: sample(state),
+            });
+        }
+    }
+    Ok(Solution {
+        summary,
+        fields,
+        turning_fields,
+        records,
+        cycles,
+        failure,
+    })
+}
+
+/// Write a solution's files into its claimed folder and swap the folder into place.
+pub(crate) fn write_solution(
+    mut folder: RunFolder,
+    scenario: &Scenario,
+    solution: &Solution,
+) -> Result<PathBuf, Error> {
+    let Solution {
+        summary,
+        fields,
+        turning_fields,
+        records,
+        cycles,
+        failure,
+    } = solution;
+    let limit = scenario.model.friction * scenario.normal_load;
+    let mut sections = Vec::new();
+    {
+        let mut put = |name: String, bytes: &[u8]| folder.write(&name, bytes);
+        put(
+            "summary.json".into(),
+            &serde_json::to_vec_pretty(summary).expect("summary serialises"),
+        )?;
+        if scenario.history.is_some() {
+            put("steps.csv".into(), &steps_csv(records, limit))?;
+            put("cycles.csv".into(), &cycles_csv(cycles))?;
+        }
+        for set in fields.iter().chain(turning_fields) {
+            put(format!("fields/{}.csv", set.stem), &fields_csv(&set.points))?;
+        }
+        let mut section = |title: &str, plots: Vec<(String, String)>| -> Result<(), Error> {
+            let mut names = Vec::new();
+            for (name, svg) in plots {
+                put(format!("plots/{name}.svg"), svg.as_bytes())?;
+                names.push(name);
+            }
+            if !names.is_empty() {
+                sections.push((title.to_string(), names));
+            }
+            Ok(())
+        };
+        section(
+            "End of normal loading",
+            normal_loading_plots(&fields[0].points),
+        )?;
+        section(
+            "Load history",
+            history_plots(records, limit, failure.is_some()),
+        )?;
+        let instants: Vec<(&str, &[SurfacePoint])> = fields[1..]
+            .iter()
+            .map(|f| (f.label.as_str(), f.points.as_slice()))
+            .collect();
+        section(
+            "Fields at the snapshot instants",
+            family_plots("snapshots", "at the snapshot instants", &instants),
+        )?;
+    }
+    if let Some(e) = failure {
+        folder.write("failure.json", &failure_json(e, records.last()))?;
+    }
+    let mut written = folder.files().to_vec();
+    written.sort();
+    folder.write(
+        "index.html",
+        index_html(&scenario.name, &sections, &written).as_bytes(),
+    )?;
+    folder.commit()
+}
+
+/// `failure.json`: the error and the last accepted step (none when normal loading failed).
+pub(crate) fn failure_json(error: &Error, last: Option<&crate::history::StepRecord>) -> Vec<u8> {
+    let body = serde_json::json!({
+        "error": error.to_string(),
+        "last_accepted_step": last,
+    });
+    serde_json::to_vec_pretty(&body).expect("serialises")
+}

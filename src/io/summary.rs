@@ -1,0 +1,231 @@
+//! `summary.json`: the derived constants, the normal-loading state, the history's results and
+//! the solver's work counters, as serialisable data.
+
+use serde::Serialize;
+
+use crate::analysis::{CycleRow, Verdict};
+use crate::contact::ContactModel;
+use crate::contact::normal::NormalLoading;
+use crate::halfplane::{PaperCoefficients, SurfaceCompliance, SurfaceFieldCoefficients};
+use crate::scenario::{RawScenario, Scenario};
+
+/// Constants derived from the material, reported in `summary.json`.
+#[derive(Debug, Serialize)]
+pub struct Derived {
+    /// Surface compliance coefficients (fretsim's convention).
+    pub compliance: SurfaceCompliance,
+    /// The same in the paper's convention (Appendix A.2).
+    pub paper_coefficients: PaperCoefficients,
+    /// Δ1…Δ4 (Section 5).
+    pub field_coefficients: SurfaceFieldCoefficients,
+    /// Effective plane-strain compliance of the pressure problem Y* (1/Pa).
+    pub pressure_compliance: f64,
+    /// Shear-to-pressure coupling κ/Y* (Dundurs' β for an elastic solid).
+    pub coupling_ratio: f64,
+    /// Charge carried by the pressure under a conducting punch, Γ1 = kP (C/m).
+    pub pressure_charge: f64,
+}
+
+/// Normal-loading results, reported in `summary.json`.
+#[derive(Debug, Serialize)]
+pub struct NormalSummary {
+    /// Contact half-width a (m).
+    pub half_width: f64,
+    /// Eccentricity e = −c (m).
+    pub eccentricity: f64,
+    /// Stick-zone half-width b (m).
+    pub stick_half_width: f64,
+    /// b/a.
+    pub stick_ratio: f64,
+    /// Slope C of the locked-in strain (1/m).
+    pub strain_slope: f64,
+    /// Peak pressure (Pa).
+    pub peak_pressure: f64,
+    /// Resultant charge Γ (C/m).
+    pub charge: f64,
+    /// Contact potential φ0 relative to the datum (V), conducting punch only.
+    pub potential: Option<f64>,
+    /// ∫p dx (N/m), equals P.
+    pub pressure_resultant: f64,
+    /// ∫g dx (C/m), equals Γ.
+    pub charge_resultant: f64,
+    /// Block iterations.
+    pub iterations: usize,
+    /// Worst admissibility violations.
+    pub admissibility: crate::contact::normal::Admissibility,
+    /// The true gap just outside the contact ends.
+    pub outside_gap: crate::contact::GapReport,
+    /// Charge carried by the pressure, Γ1 = kP (C/m).
+    pub pressure_charge: f64,
+    /// q/(ηp) in the right slip zone: +1 when the friction points outward, −1 inward (which
+    /// happens below Γ1 for a conducting punch); 0 without slip zones.
+    pub right_slip_sign: f64,
+}
+
+/// `summary.json`.
+#[derive(Debug, Serialize)]
+pub struct Summary {
+    /// fretsim version.
+    pub fretsim_version: &'static str,
+    /// The scenario as read.
+    pub scenario: RawScenario,
+    /// Derived constants.
+    pub derived: Derived,
+    /// The inputs as the solver used them.
+    pub resolved: Resolved,
+    /// Normal-loading results.
+    pub normal_loading: NormalSummary,
+    /// Tangential history results (absent without a history).
+    pub history: Option<HistorySummary>,
+    /// The field snapshots written at the requested times.
+    pub snapshots: Vec<SnapshotSummary>,
+    /// Work counters and checks.
+    pub solver: SolverStatistics,
+    /// Warnings.
+    pub warnings: Vec<String>,
+}
+
+/// Derived constants of a model at normal load P.
+pub fn derived(model: &ContactModel, normal_load: f64) -> Derived {
+    let split = model.charge_split(normal_load);
+    let ystar = model.pressure_compliance(split);
+    Derived {
+        compliance: model.compliance,
+        paper_coefficients: model.compliance.paper_coefficients(),
+        field_coefficients: model.field_coefficients,
+        pressure_compliance: ystar,
+        coupling_ratio: model.pressure_shear_coupling(split) / ystar,
+        pressure_charge: model.pressure_charge(normal_load),
+    }
+}
+
+pub(crate) fn normal_summary(model: &ContactModel, n: &NormalLoading) -> NormalSummary {
+    let s = &n.state;
+    let w_total = s.potential_charge_force();
+    NormalSummary {
+        half_width: s.half_width,
+        eccentricity: -s.centre,
+        stick_half_width: n.stick_half_width,
+        stick_ratio: n.stick_half_width / s.half_width,
+        strain_slope: n.strain_slope,
+        peak_pressure: s.pressure_at(s.centre),
+        charge: s.charge,
+        potential: s.potential,
+        pressure_resultant: s.pressure_force(),
+        // The inverse-square-root part integrates exactly from its series; the rest by quadrature.
+        charge_resultant: s.split.ratio * s.pressure_force() + w_total,
+        iterations: n.iterations,
+        admissibility: n.admissibility,
+        outside_gap: model.outside_gap(s),
+        pressure_charge: model.pressure_charge(s.normal_load),
+        right_slip_sign: s.traction.right_sign,
+    }
+}
+
+/// Summary of the tangential history, in `summary.json`.
+#[derive(Debug, Serialize)]
+pub struct HistorySummary {
+    /// Number of accepted steps after normal loading.
+    pub steps: usize,
+    /// Number of phases (monotonic segments between reversals).
+    pub phases: usize,
+    /// The states at the end of each phase: step, Q, stick ends, eccentricity.
+    pub turning_points: Vec<crate::history::StepRecord>,
+    /// The failure, if the run stopped early.
+    pub failure: Option<String>,
+    /// Per-cycle table.
+    pub cycles: Vec<CycleRow>,
+    /// Shakedown verdict.
+    pub verdict: Verdict,
+    /// Tolerance of the verdict (relative).
+    pub verdict_tolerance: f64,
+}
+
+/// Inputs as the solver used them: a preset resolved to its constants, and the load history
+/// in N/m with the cycle block expanded and the snapshot points added.
+#[derive(Debug, Serialize)]
+pub struct Resolved {
+    /// Material constants.
+    pub material: crate::material::Material,
+    /// The load history (absent without one).
+    pub load_history: Option<crate::history::LoadHistory>,
+}
+
+/// Work counters and checks of the whole run, in `summary.json`.
+#[derive(Debug, Serialize)]
+pub struct SolverStatistics {
+    /// Collocation nodes M per interval.
+    pub collocation_points: usize,
+    /// Block iterations of the normal-loading solve.
+    pub normal_loading_iterations: usize,
+    /// Accepted load steps after normal loading.
+    pub history_steps: usize,
+    /// Newton iterations summed over the history (`newton_iterations` in `steps.csv`).
+    pub newton_iterations: usize,
+    /// Most Newton iterations in one step.
+    pub max_newton_iterations: usize,
+    /// Residual evaluations summed over the history (`evaluations` in `steps.csv`).
+    pub residual_evaluations: usize,
+    /// Largest final residual of a step.
+    pub max_residual: Option<f64>,
+    /// Worst `stick_excess` of a step (≤ 0 when admissible).
+    pub worst_stick_excess: Option<f64>,
+    /// Worst `slip_reversal` of a step (≤ 0 when admissible).
+    pub worst_slip_reversal: Option<f64>,
+}
+
+/// A field snapshot at a requested time, in `summary.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SnapshotSummary {
+    /// Requested time (s), from `output.snapshots`.
+    pub t: f64,
+    /// The field file, relative to the output folder.
+    pub file: String,
+    /// The step solved at that time.
+    pub step: usize,
+    /// Time of that step (s); equals `t` within the scenario's time tolerance.
+    pub step_t: f64,
+    /// Tangential load Q (N/m).
+    pub q: f64,
+    /// Q/(ηP).
+    pub q_over_limit: f64,
+    /// Regime of the step.
+    pub regime: crate::history::Regime,
+    /// Phase of the step.
+    pub phase: usize,
+    /// Contact half-width a (m).
+    pub half_width: f64,
+    /// Eccentricity e = −c (m).
+    pub eccentricity: f64,
+    /// Stick-zone left end (m).
+    pub stick_lo: f64,
+    /// Stick-zone right end (m).
+    pub stick_hi: f64,
+}
+
+pub(crate) fn solver_statistics(
+    scenario: &Scenario,
+    normal: &NormalLoading,
+    records: &[crate::history::StepRecord],
+) -> SolverStatistics {
+    let steps = records.iter().skip(1);
+    let max = |f: &dyn Fn(&crate::history::StepRecord) -> f64| {
+        records
+            .iter()
+            .skip(1)
+            .map(f)
+            .filter(|x| x.is_finite())
+            .reduce(f64::max)
+    };
+    SolverStatistics {
+        collocation_points: scenario.collocation_points,
+        normal_loading_iterations: normal.iterations,
+        history_steps: records.len().saturating_sub(1),
+        newton_iterations: steps.clone().map(|r| r.iterations).sum(),
+        max_newton_iterations: steps.clone().map(|r| r.iterations).max().unwrap_or(0),
+        residual_evaluations: steps.map(|r| r.newton_iterations).sum(),
+        max_residual: max(&|r| r.residual),
+        worst_stick_excess: max(&|r| r.admissibility.stick_excess),
+        worst_slip_reversal: max(&|r| r.admissibility.slip_reversal),
+    }
+}
