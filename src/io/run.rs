@@ -5,15 +5,16 @@ use std::path::{Path, PathBuf};
 
 use crate::analysis::{CycleRow, analyse_cycles};
 use crate::contact::SurfacePoint;
-use crate::contact::normal::{NormalOptions, solve_normal};
+use crate::contact::normal::{NormalLoading, NormalOptions, solve_normal};
 use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
 use crate::error::Error;
+use crate::history::StepRecord;
 use crate::io::csv::{cycles_csv, fields_csv, steps_csv};
 use crate::io::folder::{Protected, RunFolder};
 use crate::io::plots::{family_plots, history_plots, index_html, normal_loading_plots};
 use crate::io::summary::{
-    HistorySummary, Resolved, SnapshotSummary, Summary, derived, normal_summary, solver_statistics,
+    Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary, solver_statistics,
 };
 use crate::scenario::Scenario;
 
@@ -169,17 +170,7 @@ pub fn solve(
             context: "normal loading".into(),
             failure,
         })?;
-    let mut warnings = Vec::new();
-    let gamma1 = model.pressure_charge(scenario.normal_load);
-    let gap = model.outside_gap(&normal.state);
-    if gap.min_gap < 0.0 {
-        warnings.push(format!(
-            "the surface interpenetrates the punch just outside the contact: gap {:.3e} m at x = {:.4e} m \
-             (a²/2R = {:.3e} m); Γ = {:.4e} C/m exceeds the charge carried by the pressure Γ1 = kP = {gamma1:.4e} C/m, \
-             and the conducting-punch model (smooth pressure at the contact ends) then admits no state with a non-negative gap",
-            gap.min_gap, gap.at, gap.scale, normal.state.charge
-        ));
-    }
+    let mut warnings: Vec<String> = gap_warning(scenario, &normal).into_iter().collect();
     // The tangential history, if any; a failure keeps the steps already solved.
     let mut records = Vec::new();
     let mut failure = None;
@@ -211,89 +202,37 @@ pub fn solve(
             }
         }
     }
-    let solver_tolerance = SlipOptions::default().tolerance;
-    let stalled: Vec<&crate::history::StepRecord> = records
-        .iter()
-        .filter(|r| r.residual >= solver_tolerance)
-        .collect();
-    if let Some(worst) = stalled
-        .iter()
-        .max_by(|x, y| x.residual.total_cmp(&y.residual))
-    {
-        warnings.push(format!(
-            "{} step(s) accepted with a stalled residual above the solver tolerance {solver_tolerance:e} \
-             (largest {:.3e} at step {}, t = {} s): the iteration stopped improving below the \
-             stall tolerance; see the residual column of steps.csv",
-            stalled.len(),
-            worst.residual,
-            worst.step,
-            worst.t
-        ));
-    }
-    let limit = model.friction * scenario.normal_load;
+    warnings.extend(stalled_warning(&records));
     let tolerance = scenario.raw.numerics.cycle_tolerance;
     let (cycles, verdict) = analyse_cycles(&records, tolerance);
-    let history_summary = scenario.history.as_ref().map(|_| {
-        let turning_points = records
-            .windows(2)
-            .filter(|w| w[0].phase != w[1].phase && w[0].phase > 0)
-            .map(|w| w[0].clone())
-            .chain(records.last().filter(|r| r.phase > 0).cloned())
-            .collect();
-        HistorySummary {
-            steps: records.len().saturating_sub(1),
-            phases: records.last().map_or(0, |r| r.phase),
-            turning_points,
-            failure: failure.as_ref().map(|e| e.to_string()),
-            cycles: cycles.clone(),
-            verdict,
-            verdict_tolerance: tolerance,
-        }
-    });
+    let history_summary = scenario
+        .history
+        .as_ref()
+        .map(|_| history_summary(&records, failure.as_ref(), &cycles, verdict, tolerance));
     // Sampled fields: the end of normal loading, then each snapshot time reached.
-    let n = scenario.raw.output.field_points;
     let sample = |state: &crate::contact::ContactState| -> Vec<SurfacePoint> {
-        field_points(state.centre, state.half_width, n)
-            .into_iter()
-            .map(|x| model.surface_point(state, x))
-            .collect()
+        field_points(
+            state.centre,
+            state.half_width,
+            scenario.raw.output.field_points,
+        )
+        .into_iter()
+        .map(|x| model.surface_point(state, x))
+        .collect()
     };
     let mut fields = vec![FieldSet {
         stem: "normal_loading".into(),
         label: "end of normal loading".into(),
         points: sample(&normal.state),
     }];
-    let mut snapshot_rows = Vec::new();
-    for (&t, kept) in scenario.snapshots.iter().zip(&snapshots.at_times) {
-        let stem = crate::scenario::snapshot_stem(t);
-        match kept {
-            Some((rec, state)) => {
-                fields.push(FieldSet {
-                    label: format!("t = {t} s, Q/(ηP) = {:.3}", rec.q / limit),
-                    stem: stem.clone(),
-                    points: sample(state),
-                });
-                snapshot_rows.push(SnapshotSummary {
-                    t,
-                    file: format!("fields/{stem}.csv"),
-                    step: rec.step,
-                    step_t: rec.t,
-                    q: rec.q,
-                    q_over_limit: rec.q / limit,
-                    regime: rec.regime,
-                    phase: rec.phase,
-                    half_width: rec.half_width,
-                    eccentricity: rec.eccentricity,
-                    stick_lo: rec.stick_lo,
-                    stick_hi: rec.stick_hi,
-                });
-            }
-            None => warnings.push(format!(
-                "snapshot t = {t} s was not reached (the history stopped at t = {} s); fields/{stem}.csv is not written",
-                records.last().map_or(f64::NAN, |r| r.t)
-            )),
-        }
-    }
+    let (at_snapshots, snapshot_rows) = snapshot_fields(
+        scenario,
+        &snapshots.at_times,
+        &sample,
+        &records,
+        &mut warnings,
+    );
+    fields.extend(at_snapshots);
     let summary = Summary {
         fretsim_version: env!("CARGO_PKG_VERSION"),
         scenario: scenario.raw.clone(),
@@ -327,6 +266,85 @@ pub fn solve(
         cycles,
         failure,
     })
+}
+
+/// The warning for a normal-loading state that interpenetrates the punch just outside the
+/// contact (a conducting punch with Γ above the charge the pressure carries).
+fn gap_warning(scenario: &Scenario, normal: &NormalLoading) -> Option<String> {
+    let model = &scenario.model;
+    let gamma1 = model.pressure_charge(scenario.normal_load);
+    let gap = model.outside_gap(&normal.state);
+    (gap.min_gap < 0.0).then(|| format!(
+        "the surface interpenetrates the punch just outside the contact: gap {:.3e} m at x = {:.4e} m \
+         (a²/2R = {:.3e} m); Γ = {:.4e} C/m exceeds the charge carried by the pressure Γ1 = kP = {gamma1:.4e} C/m, \
+         and the conducting-punch model (smooth pressure at the contact ends) then admits no state with a non-negative gap",
+        gap.min_gap, gap.at, gap.scale, normal.state.charge
+    ))
+}
+
+/// The warning for steps accepted with a residual above the solver tolerance.
+fn stalled_warning(records: &[StepRecord]) -> Option<String> {
+    let solver_tolerance = SlipOptions::default().tolerance;
+    let stalled: Vec<&StepRecord> = records
+        .iter()
+        .filter(|r| r.residual >= solver_tolerance)
+        .collect();
+    let worst = stalled
+        .iter()
+        .max_by(|x, y| x.residual.total_cmp(&y.residual))?;
+    Some(format!(
+        "{} step(s) accepted with a stalled residual above the solver tolerance {solver_tolerance:e} \
+         (largest {:.3e} at step {}, t = {} s): the iteration stopped improving below the \
+         stall tolerance; see the residual column of steps.csv",
+        stalled.len(),
+        worst.residual,
+        worst.step,
+        worst.t
+    ))
+}
+
+/// The field sets and summary rows of the snapshot times reached; a warning for each one not
+/// reached.
+fn snapshot_fields(
+    scenario: &Scenario,
+    at_times: &[Option<(StepRecord, crate::contact::ContactState)>],
+    sample: &dyn Fn(&crate::contact::ContactState) -> Vec<SurfacePoint>,
+    records: &[StepRecord],
+    warnings: &mut Vec<String>,
+) -> (Vec<FieldSet>, Vec<SnapshotSummary>) {
+    let limit = scenario.model.friction * scenario.normal_load;
+    let mut fields = Vec::new();
+    let mut rows = Vec::new();
+    for (&t, kept) in scenario.snapshots.iter().zip(at_times) {
+        let stem = crate::scenario::snapshot_stem(t);
+        let Some((rec, state)) = kept else {
+            warnings.push(format!(
+                "snapshot t = {t} s was not reached (the history stopped at t = {} s); fields/{stem}.csv is not written",
+                records.last().map_or(f64::NAN, |r| r.t)
+            ));
+            continue;
+        };
+        fields.push(FieldSet {
+            label: format!("t = {t} s, Q/(ηP) = {:.3}", rec.q / limit),
+            stem: stem.clone(),
+            points: sample(state),
+        });
+        rows.push(SnapshotSummary {
+            t,
+            file: format!("fields/{stem}.csv"),
+            step: rec.step,
+            step_t: rec.t,
+            q: rec.q,
+            q_over_limit: rec.q / limit,
+            regime: rec.regime,
+            phase: rec.phase,
+            half_width: rec.half_width,
+            eccentricity: rec.eccentricity,
+            stick_lo: rec.stick_lo,
+            stick_hi: rec.stick_hi,
+        });
+    }
+    (fields, rows)
 }
 
 /// Write a solution's files into its claimed folder and swap the folder into place.

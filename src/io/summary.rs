@@ -229,3 +229,30 @@ pub(crate) fn solver_statistics(
         worst_slip_reversal: max(&|r| r.admissibility.slip_reversal),
     }
 }
+
+/// The history's part of the summary: its steps and phases, the turning points (the last step
+/// of each phase, and the last step), the failure if the history stopped, the cycles and the
+/// verdict.
+pub(crate) fn history_summary(
+    records: &[crate::history::StepRecord],
+    failure: Option<&crate::error::Error>,
+    cycles: &[CycleRow],
+    verdict: Verdict,
+    tolerance: f64,
+) -> HistorySummary {
+    let turning_points = records
+        .windows(2)
+        .filter(|w| w[0].phase != w[1].phase && w[0].phase > 0)
+        .map(|w| w[0].clone())
+        .chain(records.last().filter(|r| r.phase > 0).cloned())
+        .collect();
+    HistorySummary {
+        steps: records.len().saturating_sub(1),
+        phases: records.last().map_or(0, |r| r.phase),
+        turning_points,
+        failure: failure.map(|e| e.to_string()),
+        cycles: cycles.to_vec(),
+        verdict,
+        verdict_tolerance: tolerance,
+    }
+}

@@ -951,8 +951,8 @@ fn reference_fretting_loop_uncoupled() {
 /// settled across the block change.
 #[test]
 fn cycle_verdicts() {
-    use fretsim::contact::normal::{NormalOptions, solve_normal};
     use fretsim::analysis::{Verdict, analyse_cycles};
+    use fretsim::contact::normal::{NormalOptions, solve_normal};
     let Uncoupled { model, p_load, .. } = uncoupled();
     let lim = model.friction * p_load;
     let disc = Discretisation::new(32);
