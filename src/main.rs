@@ -210,7 +210,7 @@ fn materials(name: Option<String>, json: bool) -> Result<(), Error> {
             .map(|p| {
                 let model = fretsim::contact::ContactModel::new(
                     p.material,
-                    1.0,
+                    fretsim::contact::Profile::cylinder(1.0),
                     0.0,
                     fretsim::contact::Electrode::None,
                 );

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::contact::{ContactModel, Coupling, Electrode};
+use crate::contact::{ContactModel, Coupling, Electrode, Profile};
 use crate::error::{Error, Issue};
 use crate::material::{IsotropicConstants, Material, PiezoConstants, preset};
 
@@ -405,11 +405,16 @@ fn build(
     history: Option<crate::history::LoadHistory>,
     time_tolerance: f64,
 ) -> Result<Scenario, Vec<Issue>> {
-    let model = ContactModel::try_new(material, raw.punch.radius, raw.friction, electrode)
-        .map_err(|failure| vec![material_issue(&raw.material, &failure)])?
-        .with_reference_distance(raw.reference_distance)
-        .with_coupling(raw.coupling)
-        .with_stick_end_kinks(raw.numerics.stick_end_kinks);
+    let model = ContactModel::try_new(
+        material,
+        Profile::cylinder(raw.punch.radius),
+        raw.friction,
+        electrode,
+    )
+    .map_err(|failure| vec![material_issue(&raw.material, &failure)])?
+    .with_reference_distance(raw.reference_distance)
+    .with_coupling(raw.coupling)
+    .with_stick_end_kinks(raw.numerics.stick_end_kinks);
     // Splitting a segment moves its steps, so repeat until every snapshot time is a step time
     // (each time is added at most once).
     let history = history.map(|mut h| {

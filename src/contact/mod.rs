@@ -58,6 +58,7 @@ pub mod frictionless;
 pub mod memory;
 pub mod normal;
 pub mod pressure;
+pub mod profile;
 pub mod roots;
 pub mod tangential;
 
@@ -67,6 +68,7 @@ use crate::error::MaterialFailure;
 use crate::halfplane::{SurfaceCompliance, SurfaceFieldCoefficients};
 use crate::material::Material;
 use crate::quadrature::{BoundedSeries, UnboundedSeries};
+pub use profile::Profile;
 
 /// How the punch is connected electrically (piezoelectric half-plane only).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -108,8 +110,8 @@ pub struct ContactModel {
     pub compliance: SurfaceCompliance,
     /// Δ1…Δ4 for the surface fields.
     pub field_coefficients: SurfaceFieldCoefficients,
-    /// Punch radius R (m).
-    pub radius: f64,
+    /// The punch's profile.
+    pub profile: Profile,
     /// Coulomb friction coefficient η (–).
     pub friction: f64,
     /// Electric boundary condition of the punch.
@@ -138,7 +140,7 @@ impl ContactModel {
     /// surface response ([`SurfaceCompliance::try_of`]).
     pub fn try_new(
         material: Material,
-        radius: f64,
+        profile: Profile,
         friction: f64,
         electrode: Electrode,
     ) -> Result<Self, MaterialFailure> {
@@ -146,7 +148,7 @@ impl ContactModel {
             compliance: SurfaceCompliance::try_of(&material)?,
             field_coefficients: SurfaceFieldCoefficients::of(&material),
             material,
-            radius,
+            profile,
             friction,
             electrode,
             reference_distance: 1e-2,
@@ -160,8 +162,8 @@ impl ContactModel {
     ///
     /// # Panics
     /// If [`Self::try_new`] fails; use that on constants from the user.
-    pub fn new(material: Material, radius: f64, friction: f64, electrode: Electrode) -> Self {
-        Self::try_new(material, radius, friction, electrode)
+    pub fn new(material: Material, profile: Profile, friction: f64, electrode: Electrode) -> Self {
+        Self::try_new(material, profile, friction, electrode)
             .unwrap_or_else(|e| panic!("contact model: {e}"))
     }
 
@@ -207,6 +209,12 @@ impl ContactModel {
     pub fn pressure_compliance(&self, split: ChargeSplit) -> f64 {
         let y23 = self.compliance.electric.map_or(0.0, |e| e.y23);
         self.compliance.y22 + split.ratio * y23
+    }
+
+    /// The pressure per unit of the collocation grid's unit response, `h''/Y*` (1/Pa·m): the
+    /// pressure equation's right-hand side for a profile of constant curvature.
+    pub fn pressure_scale(&self, split: ChargeSplit) -> f64 {
+        self.profile.pressure_scale(self.pressure_compliance(split))
     }
 
     /// κ of the pressure equation (zero under Goodman's approximation).
@@ -2395,14 +2403,14 @@ impl ContactModel {
         let slope = |x: f64| {
             self.compliance.y22 * state.pressure_cauchy(x)
                 + y23 * state.charge_cauchy(x)
-                + x / self.radius
+                + self.profile.slope(x)
         };
         let (c, a) = (state.centre, state.half_width);
         let (nodes, weights) = crate::quadrature::gauss_legendre(64);
         let mut report = GapReport {
             min_gap: f64::INFINITY,
             at: f64::NAN,
-            scale: a * a / (2.0 * self.radius),
+            scale: self.profile.gap(a),
         };
         for dir in [1.0, -1.0] {
             let end = c + dir * a;
@@ -2539,7 +2547,7 @@ impl ContactState {
         let ux = -0.5 * sums[0] - c.y11 / pi * (sums[1] + q_x * log_moment(lo, hi, x, d));
         let uz =
             0.5 * c.w12 * sums[2] - (sums[3] + normal_centre * log_moment(lo, hi, centre, d)) / pi;
-        (ux, uz + centre * centre / (2.0 * model.radius))
+        (ux, uz + model.profile.gap(centre))
     }
 
     /// Where the traction is not smooth: the stick ends, and the ends, fade ramps and centre

@@ -118,7 +118,7 @@ pub fn solve_pressure(
     let m = disc.nodes();
     let ystar = model.pressure_compliance(split);
     let kappa = model.pressure_shear_coupling(split);
-    let scale = 1.0 / (model.radius * ystar);
+    let scale = model.pressure_scale(split);
     let i1 = disc.unit_integral * scale;
     let (mut a, mut c) = guess;
     if !(a.is_finite() && a > 0.0) {

@@ -707,7 +707,7 @@ impl StepProblem<'_> {
         let mut p_nodes = vec![0.0; maps.shape_nodes.rows()];
         // The kink terms' roots and amplitudes of p and w, refilled in each pass.
         let (mut roots, mut amp, mut w_amp) = (Vec::new(), Vec::new(), Vec::new());
-        let scale = 1.0 / (model.radius * ystar);
+        let scale = model.pressure_scale(split);
         let p_scale = g.a * scale;
         let (mut lambda_p, mut lambda_q) = (0.0, 0.0);
         let mut full = false;

@@ -4,7 +4,7 @@ use approx::assert_relative_eq;
 use fretsim::analytical::{Hertz, ZhouLee};
 use fretsim::contact::frictionless::solve_frictionless;
 use fretsim::contact::pressure::Discretisation;
-use fretsim::contact::{ContactModel, Electrode};
+use fretsim::contact::{ContactModel, Electrode, Profile};
 use fretsim::material::{ALUMINIUM, Material, PZT4};
 
 /// Largest |numerical − exact| over a grid inside the contact, relative to `scale`.
@@ -32,7 +32,12 @@ fn uncoupled() -> Uncoupled {
     };
     let (p_load, eta, radius) = (2240.0, 0.3, 10e-3);
     Uncoupled {
-        model: ContactModel::new(Material::Elastic(iso), radius, eta, Electrode::None),
+        model: ContactModel::new(
+            Material::Elastic(iso),
+            Profile::cylinder(radius),
+            eta,
+            Electrode::None,
+        ),
         p_load,
         exact: fretsim::analytical::CattaneoMindlin::new(
             Hertz::new(p_load, radius, 2.0 / iso.plane_strain_modulus()),
@@ -256,7 +261,12 @@ fn ramped_state(
 
 #[test]
 fn reference_hertz_line_contact() {
-    let model = ContactModel::new(Material::Elastic(ALUMINIUM), 10e-3, 0.0, Electrode::None);
+    let model = ContactModel::new(
+        Material::Elastic(ALUMINIUM),
+        Profile::cylinder(10e-3),
+        0.0,
+        Electrode::None,
+    );
     let p_load = 2.24e3;
     let exact = Hertz::new(p_load, 10e-3, 2.0 / ALUMINIUM.plane_strain_modulus());
     for m in [16, 32, 64, 128] {
@@ -289,7 +299,7 @@ fn reference_zhou_lee_conducting_punch() {
     let gamma = 6e-7;
     let model = ContactModel::new(
         Material::Piezoelectric(PZT4),
-        60e-3,
+        Profile::cylinder(60e-3),
         0.0,
         Electrode::ConductingCharge { charge: gamma },
     );
@@ -332,8 +342,13 @@ fn reference_spence_goodman_stick_zone() {
     let beta = ALUMINIUM.dundurs_beta();
     for beta_over_eta in [0.5, 1.0, 2.0] {
         let eta = beta / beta_over_eta;
-        let model = ContactModel::new(Material::Elastic(ALUMINIUM), 10e-3, eta, Electrode::None)
-            .with_coupling(Coupling::Goodman);
+        let model = ContactModel::new(
+            Material::Elastic(ALUMINIUM),
+            Profile::cylinder(10e-3),
+            eta,
+            Electrode::None,
+        )
+        .with_coupling(Coupling::Goodman);
         let exact = spence_stick_ratio(beta_over_eta);
         let c_exact = spence_strain_slope(eta, 10e-3, exact);
         let mut errors = Vec::new();
@@ -375,7 +390,7 @@ fn reference_zhou_lee_half_width_from_appendix_a2() {
     let a_paper = (2.0 * 2000.0 * 60e-3 * ystar / std::f64::consts::PI).sqrt();
     let model = ContactModel::new(
         Material::Piezoelectric(PZT4),
-        60e-3,
+        Profile::cylinder(60e-3),
         0.0,
         Electrode::ConductingCharge { charge: 6e-7 },
     );
@@ -395,7 +410,7 @@ fn reference_zhou_lee_half_width_from_appendix_a2() {
 fn resultants_and_potential_control_round_trip() {
     let charge = ContactModel::new(
         Material::Piezoelectric(PZT4),
-        60e-3,
+        Profile::cylinder(60e-3),
         0.0,
         Electrode::ConductingCharge { charge: 6e-7 },
     );
@@ -417,7 +432,7 @@ fn resultants_and_potential_control_round_trip() {
     let phi0 = s.potential.unwrap();
     let potential = ContactModel::new(
         Material::Piezoelectric(PZT4),
-        60e-3,
+        Profile::cylinder(60e-3),
         0.0,
         Electrode::ConductingPotential { potential: phi0 },
     );
@@ -434,7 +449,7 @@ fn reference_surface_fields_frictionless_conducting() {
     let gamma = 6e-7;
     let model = ContactModel::new(
         Material::Piezoelectric(PZT4),
-        60e-3,
+        Profile::cylinder(60e-3),
         0.0,
         Electrode::ConductingCharge { charge: gamma },
     );
@@ -486,7 +501,12 @@ fn paper_trends_figures_8_and_9() {
     use fretsim::contact::normal::{NormalOptions, solve_normal};
     let disc = Discretisation::new(32);
     let solve = |electrode, eta| {
-        let model = ContactModel::new(Material::Piezoelectric(PZT4), 60e-3, eta, electrode);
+        let model = ContactModel::new(
+            Material::Piezoelectric(PZT4),
+            Profile::cylinder(60e-3),
+            eta,
+            electrode,
+        );
         let s = solve_normal(&model, &disc, 2000.0, NormalOptions::default()).unwrap();
         (
             s.stick_half_width / s.state.half_width,
@@ -527,7 +547,7 @@ fn electric_load_across_gamma1_switches_the_slip_direction() {
     for (gamma, sign) in [(0.0, -1.0), (3e-7, -1.0), (6e-7, 1.0), (9e-7, 1.0)] {
         let model = ContactModel::new(
             Material::Piezoelectric(PZT4),
-            60e-3,
+            Profile::cylinder(60e-3),
             0.3,
             Electrode::ConductingCharge { charge: gamma },
         );
@@ -553,7 +573,7 @@ fn friction_limits_tend_to_frictionless_and_to_full_stick() {
     let model = |eta| {
         ContactModel::new(
             Material::Piezoelectric(PZT4),
-            60e-3,
+            Profile::cylinder(60e-3),
             eta,
             Electrode::ConductingCharge { charge: 6e-7 },
         )
@@ -699,7 +719,12 @@ impl fretsim::history::Observer for Recorder {
 /// baseline), and with Γ < Γ1 none.
 #[test]
 fn reference_gap_outside_the_contact() {
-    let model = ContactModel::new(Material::Elastic(ALUMINIUM), 10e-3, 0.0, Electrode::None);
+    let model = ContactModel::new(
+        Material::Elastic(ALUMINIUM),
+        Profile::cylinder(10e-3),
+        0.0,
+        Electrode::None,
+    );
     let s = solve_frictionless(&model, &Discretisation::new(32), 2.24e3).unwrap();
     let g = model.outside_gap(&s);
     let a = s.half_width;
@@ -724,7 +749,7 @@ fn reference_gap_outside_the_contact() {
     for (gamma, negative) in [(6e-7, true), (3e-7, false)] {
         let m = ContactModel::new(
             Material::Piezoelectric(PZT4),
-            60e-3,
+            Profile::cylinder(60e-3),
             0.0,
             Electrode::ConductingCharge { charge: gamma },
         );
@@ -754,7 +779,7 @@ fn normal_loading_strain_matches_the_memory_in_the_stick_zone() {
     use fretsim::contact::normal::{NormalOptions, solve_normal};
     let model = ContactModel::new(
         Material::Piezoelectric(PZT4),
-        60e-3,
+        Profile::cylinder(60e-3),
         0.3,
         Electrode::ConductingCharge { charge: 6e-7 },
     );
@@ -789,7 +814,7 @@ fn normal_loading_converges_in_m() {
     use fretsim::contact::normal::{NormalOptions, solve_normal};
     let model = ContactModel::new(
         Material::Piezoelectric(PZT4),
-        60e-3,
+        Profile::cylinder(60e-3),
         0.3,
         Electrode::ConductingCharge { charge: 6e-7 },
     );
@@ -1320,7 +1345,12 @@ fn steady_cycle_mirror_mismatch_vanishes_with_beta() {
             shear_modulus: 27.3e9,
             poisson_ratio: nu,
         };
-        let model = ContactModel::new(Material::Elastic(iso), radius, eta, Electrode::None);
+        let model = ContactModel::new(
+            Material::Elastic(iso),
+            Profile::cylinder(radius),
+            eta,
+            Electrode::None,
+        );
         let normal = solve_normal(&model, &disc, p_load, NormalOptions::default()).unwrap();
         let points = vec![
             (0.0, 0.0),
