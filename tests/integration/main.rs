@@ -1,4 +1,5 @@
 //! The one integration-test binary: reference solutions, scenarios and the command line.
 
 mod cli;
+mod fuzz;
 mod reference;
