@@ -17,6 +17,15 @@ use serde_json::Value;
 const SEED: u64 = 0x35_f0_22_ed;
 /// Mutated cases per scenario file, in-process.
 const CASES_PER_FILE: usize = 300;
+
+/// A longer campaign by hand: `FRETSIM_FUZZ_CASES` (cases per file) and `FRETSIM_FUZZ_SEED`.
+fn campaign() -> (u64, usize) {
+    let var = |name: &str| std::env::var(name).ok().and_then(|v| v.parse().ok());
+    (
+        var("FRETSIM_FUZZ_SEED").unwrap_or(SEED),
+        var("FRETSIM_FUZZ_CASES").map_or(CASES_PER_FILE, |n: u64| n as usize),
+    )
+}
 /// Cases through the command, spread over the files.
 const COMMAND_CASES: usize = 160;
 /// `run` only the valid cases this short (load steps) and this small (M), to stay fast.
@@ -345,10 +354,11 @@ fn steps_of(sc: &fretsim::scenario::Scenario) -> usize {
 #[test]
 fn mutated_scenarios_never_panic_in_the_library() {
     let started = Instant::now();
-    let mut rng = SplitMix(SEED);
+    let (seed, cases) = campaign();
+    let mut rng = SplitMix(seed);
     let (mut valid, mut invalid, mut unparsed) = (0, 0, 0);
     for (path, text) in scenario_files() {
-        for k in 0..CASES_PER_FILE {
+        for k in 0..cases {
             let mutated = case(&mut rng, &text);
             let outcome = std::panic::catch_unwind(|| answer(&mutated));
             let Ok(result) = outcome else {
@@ -380,7 +390,7 @@ fn mutated_scenarios_never_panic_in_the_library() {
         }
     }
     eprintln!(
-        "fuzz (seed {SEED:#x}): {} cases in-process, {valid} valid, {invalid} invalid, {unparsed} unparsed, {:.2} s",
+        "fuzz (seed {seed:#x}): {} cases in-process, {valid} valid, {invalid} invalid, {unparsed} unparsed, {:.2} s",
         valid + invalid + unparsed,
         started.elapsed().as_secs_f64()
     );
