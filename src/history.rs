@@ -199,16 +199,23 @@ impl LoadHistory {
         issues
     }
 
+    /// The number of steps of segment `k` (from point `k` to point `k + 1`):
+    /// `max(steps_per_segment, ⌈|ΔQ|/max_step⌉)`, one for a hold.
+    pub fn segment_steps(&self, k: usize) -> usize {
+        let (q0, q1) = (self.points[k].1, self.points[k + 1].1);
+        let n = self
+            .steps_per_segment
+            .max(((q1 - q0).abs() / self.max_step).ceil() as usize)
+            .max(1);
+        if (q1 - q0).abs() > 0.0 { n } else { 1 }
+    }
+
     /// The load steps `(t, Q)` after the first point, each with its segment index.
     pub fn steps(&self) -> Vec<(usize, f64, f64)> {
         let mut out = Vec::new();
         for (k, w) in self.points.windows(2).enumerate() {
             let ((t0, q0), (t1, q1)) = (w[0], w[1]);
-            let n = self
-                .steps_per_segment
-                .max(((q1 - q0).abs() / self.max_step).ceil() as usize)
-                .max(1);
-            let n = if (q1 - q0).abs() > 0.0 { n } else { 1 };
+            let n = self.segment_steps(k);
             for i in 1..=n {
                 let f = i as f64 / n as f64;
                 out.push((k, t0 + f * (t1 - t0), q0 + f * (q1 - q0)));

@@ -415,15 +415,8 @@ fn build(
     .with_reference_distance(raw.reference_distance)
     .with_coupling(raw.coupling)
     .with_stick_end_kinks(raw.numerics.stick_end_kinks);
-    // Splitting a segment moves its steps, so repeat until every snapshot time is a step time
-    // (each time is added at most once).
     let history = history.map(|mut h| {
-        while raw
-            .output
-            .snapshots
-            .iter()
-            .any(|&t| insert_snapshot_point(&mut h, t, time_tolerance))
-        {}
+        insert_snapshot_points(&mut h, &raw.output.snapshots, time_tolerance);
         h
     });
     // Each added point can add up to `steps_per_segment` steps.
@@ -915,33 +908,72 @@ fn validate_output(
     tol
 }
 
-/// Make `t` a step time of `history`: if no step (nor the end of normal loading, nor the first
-/// point) falls within `tol` of it, add the point `(t, Q(t))` of the piecewise-linear history.
-/// Q(t) is unchanged; the segment that held `t` is split in two, each cut into steps by the
-/// usual rule. Returns whether a point was added.
-fn insert_snapshot_point(history: &mut crate::history::LoadHistory, t: f64, tol: f64) -> bool {
-    let Some(&(t0, _)) = history.points.first() else {
-        return false;
-    };
-    let on_grid = (t - t0).abs() <= tol
-        || history
-            .steps()
-            .iter()
-            .any(|&(_, ts, _)| (ts - t).abs() <= tol);
-    if on_grid {
-        return false;
+/// Make every snapshot time (strictly increasing) a step time of `history`: where no step
+/// (nor the end of normal loading, nor the first point) falls within `tol` of a time, add the
+/// point `(t, Q(t))` of the piecewise-linear history. Q(t) is unchanged; the segment that held
+/// `t` is split in two, each cut into steps by the usual rule. Splitting a segment moves its
+/// steps, so the times already passed are checked again from the split segment's start (each
+/// time is added at most once): the result is that of rescanning all times after every
+/// addition until none is added, in about one pass.
+fn insert_snapshot_points(history: &mut crate::history::LoadHistory, snapshots: &[f64], tol: f64) {
+    let mut i = 0;
+    while let Some(&t) = snapshots.get(i) {
+        match insert_snapshot_point(history, t, tol) {
+            // Times below the split segment's start minus tol keep their nearest steps.
+            Some(start) => i = snapshots.partition_point(|&s| s < start - tol),
+            None => i += 1,
+        }
     }
-    let Some(k) = history
-        .points
-        .windows(2)
-        .position(|w| w[0].0 < t && t < w[1].0)
-    else {
-        return false;
-    };
+}
+
+/// Add `(t, Q(t))` to `history` unless `t` is within `tol` of a step time, the first point or
+/// lies in no segment; returns the start time of the segment that was split.
+fn insert_snapshot_point(
+    history: &mut crate::history::LoadHistory,
+    t: f64,
+    tol: f64,
+) -> Option<f64> {
+    let &(t0, _) = history.points.first()?;
+    if (t - t0).abs() <= tol || near_a_step(history, t, tol) {
+        return None;
+    }
+    // Points are strictly increasing in t: the segment with w0.t < t < w1.t.
+    let above = history.points.partition_point(|p| p.0 < t);
+    if above == 0 || above == history.points.len() || history.points[above].0 <= t {
+        return None;
+    }
+    let k = above - 1;
     let ((ta, qa), (tb, qb)) = (history.points[k], history.points[k + 1]);
     let q = qa + (t - ta) / (tb - ta) * (qb - qa);
     history.points.insert(k + 1, (t, q));
-    true
+    Some(ta)
+}
+
+/// Whether a step time of `history` lies within `tol` of `t`. Step `i` of `n` on the segment
+/// `[ta, tb]` is at `ta + (i/n)(tb − ta)` ([`crate::history::LoadHistory::steps`]), increasing
+/// in `i`, so only the segments around `t` and the steps next to its position are looked at.
+fn near_a_step(history: &crate::history::LoadHistory, t: f64, tol: f64) -> bool {
+    let points = &history.points;
+    // Steps of segment k lie in [t_k, t_{k+1}] up to round-off; 2 tol covers it.
+    let first = points
+        .partition_point(|p| p.0 < t - 2.0 * tol)
+        .saturating_sub(1);
+    (first..points.len().saturating_sub(1))
+        .take_while(|&k| points[k].0 <= t + 2.0 * tol)
+        .any(|k| {
+            let (ta, tb) = (points[k].0, points[k + 1].0);
+            let n = history.segment_steps(k);
+            let at = ((t - ta) / (tb - ta) * n as f64).round();
+            let at = if at.is_finite() {
+                at.clamp(0.0, n as f64) as usize
+            } else {
+                0
+            };
+            (at.saturating_sub(2).max(1)..=(at + 2).min(n)).any(|i| {
+                let f = i as f64 / n as f64;
+                (ta + f * (tb - ta) - t).abs() <= tol
+            })
+        })
 }
 
 #[cfg(test)]
@@ -1286,6 +1318,110 @@ mod history_tests {
         assert_eq!(
             found[0].to_string(),
             "`output.snapshots` = 10001 times is invalid; it must hold at most 10000"
+        );
+    }
+
+    /// The former rule, one time at a time over the whole step list: the oracle.
+    #[allow(clippy::doc_lazy_continuation)]
+    /// Make `t` a step time of `history`: if no step (nor the end of normal loading, nor the first
+    /// point) falls within `tol` of it, add the point `(t, Q(t))` of the piecewise-linear history.
+    /// Q(t) is unchanged; the segment that held `t` is split in two, each cut into steps by the
+    /// usual rule. Returns whether a point was added.
+    fn insert_snapshot_point_by_rescanning(
+        history: &mut crate::history::LoadHistory,
+        t: f64,
+        tol: f64,
+    ) -> bool {
+        let Some(&(t0, _)) = history.points.first() else {
+            return false;
+        };
+        let on_grid = (t - t0).abs() <= tol
+            || history
+                .steps()
+                .iter()
+                .any(|&(_, ts, _)| (ts - t).abs() <= tol);
+        if on_grid {
+            return false;
+        }
+        let Some(k) = history
+            .points
+            .windows(2)
+            .position(|w| w[0].0 < t && t < w[1].0)
+        else {
+            return false;
+        };
+        let ((ta, qa), (tb, qb)) = (history.points[k], history.points[k + 1]);
+        let q = qa + (t - ta) / (tb - ta) * (qb - qa);
+        history.points.insert(k + 1, (t, q));
+        true
+    }
+
+    #[test]
+    fn snapshot_points_match_rescanning_after_every_addition() {
+        // Random histories and snapshot sets (fixed seed): the same points as the former
+        // rule, which rescanned every time against every step after each addition.
+        let mut state = 0x5eed_u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for case in 0..300 {
+            let n = 2 + (next() * 6.0) as usize;
+            let mut t = 0.0;
+            let points: Vec<(f64, f64)> = (0..n)
+                .map(|_| {
+                    let p = (t, 2.0 * next() - 1.0);
+                    t += 0.1 + next() * 3.0;
+                    p
+                })
+                .collect();
+            let base = crate::history::LoadHistory {
+                points,
+                steps_per_segment: 1 + (next() * 12.0) as usize,
+                max_step: 0.02 + next() * 0.3,
+            };
+            let span = base.points.last().unwrap().0;
+            let mut snaps: Vec<f64> = (0..(next() * 40.0) as usize)
+                .map(|_| {
+                    let s = next() * span;
+                    // Half of them on a step time, to exercise the tolerance.
+                    if next() < 0.5 {
+                        let steps = base.steps();
+                        steps[(next() * steps.len() as f64) as usize].1
+                    } else {
+                        s
+                    }
+                })
+                .collect();
+            snaps.sort_by(f64::total_cmp);
+            snaps.dedup();
+            let tol = 1e-9 * span;
+            let mut fast = base.clone();
+            insert_snapshot_points(&mut fast, &snaps, tol);
+            let mut slow = base.clone();
+            while snaps
+                .iter()
+                .any(|&t| insert_snapshot_point_by_rescanning(&mut slow, t, tol))
+            {}
+            assert_eq!(fast, slow, "case {case}");
+        }
+    }
+
+    #[test]
+    fn ten_thousand_snapshots_are_placed_quickly() {
+        let times: Vec<String> = (1..=MAX_SNAPSHOTS)
+            .map(|i| format!("{}", i as f64 * 1e-4))
+            .collect();
+        let text = with_output(&format!("{{\"snapshots\": [{}]}}", times.join(", ")));
+        let started = std::time::Instant::now();
+        let s = validate(parse(&text, Path::new("t.json")).unwrap()).unwrap();
+        assert!(s.history.unwrap().points.len() > 1000);
+        assert!(
+            started.elapsed().as_secs_f64() < 5.0,
+            "{:?}",
+            started.elapsed()
         );
     }
 

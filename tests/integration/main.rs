@@ -1,5 +1,6 @@
 //! The one integration-test binary: reference solutions, scenarios and the command line.
 
 mod cli;
+mod fuzz;
 mod output_safety;
 mod reference;
