@@ -151,10 +151,7 @@ fn sweep(
         source,
     })?;
     let out = out.unwrap_or_else(|| PathBuf::from("output").join(format!("{}-sweep", sc.name)));
-    let total = vary.iter().map(|v| v.values.len()).product::<usize>();
-    let variants = (0..total)
-        .filter(|i| options.shard.is_none_or(|s| i % s.count == s.index - 1))
-        .count();
+    let variants = io::sweep::shard_count(io::sweep::variant_count(vary, path)?, options.shard);
     let progress = Progress::new(variants as u64, quiet);
     let bar = progress.0.clone();
     if let Some(b) = &bar {

@@ -151,6 +151,29 @@ pub(crate) fn set_path(value: &mut serde_json::Value, path: &str, x: f64) -> Res
 mod vary_tests {
     use super::*;
 
+    /// A shard runs the variants i with i mod N = I − 1: counted without listing them, and
+    /// the product of the counts without overflow.
+    #[test]
+    fn shard_and_variant_counts() {
+        for total in 0..20 {
+            for count in 1..6 {
+                for index in 1..=count {
+                    let listed = (0..total).filter(|i| i % count == index - 1).count();
+                    let shard = Some(Shard { index, count });
+                    assert_eq!(shard_count(total, shard), listed, "{total} {index}/{count}");
+                }
+            }
+            assert_eq!(shard_count(total, None), total);
+        }
+        let wide: Vary = "friction=0:1:100000".parse().unwrap();
+        let err = variant_count(&[wide.clone(), wide.clone(), wide], Path::new("s.json"));
+        assert!(
+            err.unwrap_err()
+                .to_string()
+                .contains("100000 × 100000 × 100000 variants")
+        );
+    }
+
     #[test]
     fn a_vary_count_above_the_variant_limit_is_rejected() {
         assert_eq!(
@@ -262,6 +285,34 @@ pub(crate) fn variant_label(vary: &[Vary], values: &[f64]) -> String {
         .join(", ")
 }
 
+/// The number of variants of a sweep (the product of the ranges' counts), or an input error
+/// when it exceeds [`MAX_SWEEP_VARIANTS`].
+pub fn variant_count(vary: &[Vary], source: &Path) -> Result<usize, Error> {
+    vary.iter()
+        .try_fold(1usize, |n, v| n.checked_mul(v.values.len()))
+        .filter(|&n| n <= MAX_SWEEP_VARIANTS)
+        .ok_or_else(|| {
+            let counts: Vec<String> = vary.iter().map(|v| v.values.len().to_string()).collect();
+            Error::InvalidScenario {
+                path: source.to_path_buf(),
+                issues: vec![crate::error::Issue::new(
+                    "--vary",
+                    format!(
+                        "{} variants is invalid; it must be at most {MAX_SWEEP_VARIANTS}",
+                        counts.join(" × ")
+                    ),
+                )],
+            }
+        })
+}
+
+/// The variants that shard `shard` of a sweep of `total` runs: every N-th from the I-th.
+pub fn shard_count(total: usize, shard: Option<Shard>) -> usize {
+    shard.map_or(total, |s| {
+        total.saturating_sub(s.index - 1).div_ceil(s.count)
+    })
+}
+
 /// The scenario variants of a sweep: every point of the Cartesian product of `vary` (in the
 /// shard), validated before any is solved.
 pub(crate) fn sweep_variants(
@@ -277,23 +328,7 @@ pub(crate) fn sweep_variants(
         column: e.column(),
         message: e.to_string(),
     })?;
-    let total = vary
-        .iter()
-        .try_fold(1usize, |n, v| n.checked_mul(v.values.len()))
-        .filter(|&n| n <= MAX_SWEEP_VARIANTS);
-    if total.is_none() {
-        let counts: Vec<String> = vary.iter().map(|v| v.values.len().to_string()).collect();
-        return Err(Error::InvalidScenario {
-            path: source.to_path_buf(),
-            issues: vec![crate::error::Issue::new(
-                "--vary",
-                format!(
-                    "{} variants is invalid; it must be at most {MAX_SWEEP_VARIANTS}",
-                    counts.join(" × ")
-                ),
-            )],
-        });
-    }
+    variant_count(vary, source)?;
     // Cartesian product of the values.
     let mut combos: Vec<Vec<f64>> = vec![Vec::new()];
     for v in vary {
