@@ -1,0 +1,217 @@
+//! The scenario file's serde shape, strict: unknown fields are errors. All quantities SI.
+
+use serde::{Deserialize, Serialize};
+
+use crate::contact::Coupling;
+use crate::material::PiezoConstants;
+
+/// Scenario as written in the file.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawScenario {
+    /// Name, used for the default output folder `output/<name>/`.
+    #[serde(default = "default_name")]
+    pub name: String,
+    /// The half-plane.
+    pub material: RawMaterial,
+    /// The punch.
+    pub punch: RawPunch,
+    /// Coulomb friction coefficient η (–), ≥ 0.
+    pub friction: f64,
+    /// Normal load P (N/m), > 0.
+    pub normal_load: f64,
+    /// Datum distance d of the regularised log kernel (m), > 0 (default 0.01 m).
+    #[serde(default = "default_reference_distance")]
+    pub reference_distance: f64,
+    /// Shear–pressure coupling: `full` (default) or `goodman`.
+    #[serde(default)]
+    pub coupling: Coupling,
+    /// Numerical settings.
+    #[serde(default)]
+    pub numerics: RawNumerics,
+    /// Tangential load history after normal loading (optional).
+    #[serde(default)]
+    pub tangential_history: Option<RawHistory>,
+    /// Output options.
+    #[serde(default)]
+    pub output: RawOutput,
+}
+
+/// Output options.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawOutput {
+    /// Times t (s, in the history's time axis) at which the fields are written to
+    /// `fields/t_<t>.csv` and plotted; strictly increasing, within the history's span.
+    #[serde(default)]
+    pub snapshots: Vec<f64>,
+    /// Also write `fields/step_NNNNN.csv` at every turning point and at the last step
+    /// (default true).
+    #[serde(default = "default_true")]
+    pub turning_point_fields: bool,
+    /// Sample points per field file (a multiple of 4 in [16, 100000], default 400).
+    #[serde(default = "default_field_points")]
+    pub field_points: usize,
+}
+
+impl Default for RawOutput {
+    fn default() -> Self {
+        Self {
+            snapshots: Vec::new(),
+            turning_point_fields: true,
+            field_points: default_field_points(),
+        }
+    }
+}
+
+pub(super) fn default_true() -> bool {
+    true
+}
+
+pub(super) fn default_field_points() -> usize {
+    400
+}
+
+/// Unit of the tangential loads in a history.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum LoadUnit {
+    /// Q as a fraction of ηP (default).
+    #[default]
+    FractionOfLimit,
+    /// Q in N/m.
+    NewtonPerMetre,
+}
+
+/// A piecewise-linear Q(t): `points` (lead-in, from Q = 0 at the end of normal loading),
+/// then `cycle` repeated `repeats` times (cycle times relative to the start of each repeat).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawHistory {
+    /// Unit of Q and of `max_step`.
+    #[serde(default)]
+    pub unit: LoadUnit,
+    /// `[t (s), Q]` points.
+    pub points: Vec<(f64, f64)>,
+    /// `[Δt (s), Q]` points of a repeated block.
+    #[serde(default)]
+    pub cycle: Vec<(f64, f64)>,
+    /// Number of repeats of `cycle` (≥ 0, default 1).
+    #[serde(default = "default_repeats")]
+    pub repeats: usize,
+    /// Minimum number of load steps per segment (≥ 1, default 10).
+    #[serde(default = "default_steps")]
+    pub steps_per_segment: usize,
+    /// Largest load step, in the unit of Q (> 0, default 0.05 ηP).
+    #[serde(default)]
+    pub max_step: Option<f64>,
+}
+
+pub(super) fn default_repeats() -> usize {
+    1
+}
+
+pub(super) fn default_steps() -> usize {
+    10
+}
+
+pub(super) fn default_name() -> String {
+    "scenario".to_string()
+}
+
+pub(super) fn default_reference_distance() -> f64 {
+    1e-2
+}
+
+/// Material: a preset by name, or constants.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum RawMaterial {
+    /// `{"kind": "preset", "name": "pzt4"}`.
+    Preset {
+        /// Preset name (`fretsim materials` lists them).
+        name: String,
+    },
+    /// `{"kind": "piezoelectric", "c11": …, …}` (Pa, C/m², C/(V·m)).
+    Piezoelectric(PiezoConstants),
+    /// `{"kind": "elastic", "shear_modulus" or "youngs_modulus": …, "poisson_ratio": …}`.
+    Elastic {
+        /// μ (Pa).
+        #[serde(default)]
+        shear_modulus: Option<f64>,
+        /// E (Pa).
+        #[serde(default)]
+        youngs_modulus: Option<f64>,
+        /// ν (–).
+        poisson_ratio: f64,
+    },
+}
+
+/// The punch.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawPunch {
+    /// Radius R (m), > 0.
+    pub radius: f64,
+    /// Electric boundary condition (default: none, for an elastic half-plane).
+    #[serde(default)]
+    pub electrode: RawElectrode,
+}
+
+/// Electrode model.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum RawElectrode {
+    /// No electric load (elastic half-plane).
+    #[default]
+    None,
+    /// Conducting punch with either `charge` Γ (C/m) or `potential` φ0 (V).
+    Conducting {
+        /// Γ (C/m).
+        #[serde(default)]
+        charge: Option<f64>,
+        /// φ0 (V).
+        #[serde(default)]
+        potential: Option<f64>,
+    },
+    /// Insulating punch: no surface charge on the contact (`g ≡ 0`).
+    Insulating {},
+}
+
+/// Numerical settings.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawNumerics {
+    /// Number of collocation nodes M per interval (8 ≤ M ≤ 1024, default 64).
+    #[serde(default = "default_m")]
+    pub collocation_points: usize,
+    /// Relative tolerance for "a cycle repeats its predecessor" in the shakedown verdict
+    /// (0 < tol < 1, default 1e−6).
+    #[serde(default = "default_cycle_tolerance")]
+    pub cycle_tolerance: f64,
+    /// Carry the square-root kinks of p and w at the stick ends in closed form (default true).
+    #[serde(default = "default_stick_end_kinks")]
+    pub stick_end_kinks: bool,
+}
+
+pub(super) fn default_stick_end_kinks() -> bool {
+    true
+}
+
+pub(super) fn default_cycle_tolerance() -> f64 {
+    1e-6
+}
+
+pub(super) fn default_m() -> usize {
+    64
+}
+
+impl Default for RawNumerics {
+    fn default() -> Self {
+        Self {
+            collocation_points: default_m(),
+            cycle_tolerance: default_cycle_tolerance(),
+            stick_end_kinks: default_stick_end_kinks(),
+        }
+    }
+}

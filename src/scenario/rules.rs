@@ -1,0 +1,478 @@
+//! The validation rules, one function per section of the file (material, electrode, loads,
+//! history, numerics, output); each pushes every problem it finds, with its JSON path.
+
+use crate::contact::Electrode;
+use crate::error::Issue;
+use crate::material::{IsotropicConstants, Material, preset};
+
+use super::*;
+
+pub(super) fn positive(issues: &mut Vec<Issue>, path: &str, value: f64, unit: &str) {
+    if !(value.is_finite() && value > 0.0) {
+        issues.push(Issue::new(
+            path,
+            format!("{value} {unit} is invalid; it must be finite and > 0"),
+        ));
+    }
+}
+
+/// The name is a plain file name: it becomes the folder `output/<name>/`.
+pub(super) fn validate_name(issues: &mut Vec<Issue>, name: &str) {
+    let plain = name
+        .chars()
+        .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
+    if !plain || name.is_empty() || name == "." || name == ".." {
+        issues.push(Issue::new(
+            "name",
+            format!(
+                "{name:?} is invalid; it must be a plain name of ASCII letters, digits, `-`, `_` and `.`, \
+                 not empty, `.` or `..` (it names the folder output/<name>)"
+            ),
+        ));
+    }
+}
+
+/// The issue for constants whose surface response cannot be computed.
+pub(super) fn material_issue(raw: &RawMaterial, failure: &crate::error::MaterialFailure) -> Issue {
+    Issue::new(
+        material_path(raw),
+        format!(
+            "these constants are invalid; they must give a half-plane surface response ({failure})"
+        ),
+    )
+}
+
+pub(super) fn material_path(raw: &RawMaterial) -> &'static str {
+    match raw {
+        RawMaterial::Preset { .. } => "material.name",
+        _ => "material",
+    }
+}
+
+/// The material: a preset, or constants in range with a computable surface response.
+pub(super) fn resolve_material(issues: &mut Vec<Issue>, raw: &RawMaterial) -> Option<Material> {
+    let material = match raw {
+        RawMaterial::Preset { name } => match preset(name) {
+            Some(p) => Some(p.material),
+            None => {
+                let names: Vec<_> = crate::material::presets().iter().map(|p| p.name).collect();
+                issues.push(Issue::new(
+                    "material.name",
+                    format!(
+                        "\"{name}\" is invalid; it must be one of {}",
+                        names.join(", ")
+                    ),
+                ));
+                None
+            }
+        },
+        RawMaterial::Piezoelectric(c) => Some(Material::Piezoelectric(*c)),
+        RawMaterial::Elastic {
+            shear_modulus,
+            youngs_modulus,
+            poisson_ratio,
+        } => match (shear_modulus, youngs_modulus) {
+            (Some(mu), None) => Some(Material::Elastic(IsotropicConstants {
+                shear_modulus: *mu,
+                poisson_ratio: *poisson_ratio,
+            })),
+            (None, Some(e)) => {
+                // E and ν are the inputs: check them, not the derived μ.
+                let found = crate::material::validate_youngs("material", *e, *poisson_ratio);
+                let ok = found.is_empty();
+                issues.extend(found);
+                let m = IsotropicConstants::from_youngs(*e, *poisson_ratio);
+                return ok.then(|| surface_response(issues, raw, Material::Elastic(m)))?;
+            }
+            _ => {
+                issues.push(Issue::new(
+                    "material",
+                    "an elastic material is invalid without exactly one of `shear_modulus` and `youngs_modulus`",
+                ));
+                None
+            }
+        },
+    }?;
+    let found = material.validate(material_path(raw));
+    let ok = found.is_empty();
+    issues.extend(found);
+    ok.then(|| surface_response(issues, raw, material))?
+}
+
+/// `Some(material)` when its surface response can be computed, else an issue.
+pub(super) fn surface_response(
+    issues: &mut Vec<Issue>,
+    raw: &RawMaterial,
+    m: Material,
+) -> Option<Material> {
+    match crate::halfplane::SurfaceCompliance::try_of(&m) {
+        Ok(_) => Some(m),
+        Err(failure) => {
+            issues.push(material_issue(raw, &failure));
+            None
+        }
+    }
+}
+
+/// Punch radius, loads, datum distance and friction.
+pub(super) fn validate_loads(issues: &mut Vec<Issue>, raw: &RawScenario) {
+    positive(issues, "punch.radius", raw.punch.radius, "m");
+    positive(issues, "normal_load", raw.normal_load, "N/m");
+    positive(issues, "reference_distance", raw.reference_distance, "m");
+    if !(raw.friction.is_finite() && raw.friction >= 0.0) {
+        issues.push(Issue::new(
+            "friction",
+            format!("{} is invalid; it must be finite and ≥ 0", raw.friction),
+        ));
+    }
+}
+
+pub(super) fn validate_numerics(issues: &mut Vec<Issue>, numerics: &RawNumerics) {
+    let m = numerics.collocation_points;
+    let tol = numerics.cycle_tolerance;
+    if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
+        issues.push(Issue::new(
+            "numerics.cycle_tolerance",
+            format!("{tol} is invalid; it must lie in (0, 1)"),
+        ));
+    }
+    if !(8..=MAX_COLLOCATION_POINTS).contains(&m) {
+        issues.push(Issue::new(
+            "numerics.collocation_points",
+            format!("{m} is invalid; it must lie in [8, {MAX_COLLOCATION_POINTS}]"),
+        ));
+    }
+}
+
+/// The electrode, consistent with the material (`piezo` is `None` when the material is
+/// invalid).
+pub(super) fn resolve_electrode(
+    issues: &mut Vec<Issue>,
+    raw: &RawElectrode,
+    piezo: Option<bool>,
+) -> Option<Electrode> {
+    match (raw, piezo) {
+        (RawElectrode::None, Some(true)) => {
+            issues.push(Issue::new(
+                "punch.electrode",
+                "none is invalid for a piezoelectric half-plane; it must be `conducting` or `insulating`",
+            ));
+            None
+        }
+        (RawElectrode::None, _) => Some(Electrode::None),
+        (_, Some(false)) => {
+            issues.push(Issue::new(
+                "punch.electrode",
+                "an electric load is invalid for an elastic half-plane; it must be {\"kind\": \"none\"} or omitted",
+            ));
+            None
+        }
+        (RawElectrode::Conducting { charge, potential }, _) => match (charge, potential) {
+            (Some(g), None) if g.is_finite() => Some(Electrode::ConductingCharge { charge: *g }),
+            (None, Some(v)) if v.is_finite() => {
+                Some(Electrode::ConductingPotential { potential: *v })
+            }
+            (Some(g), None) => {
+                issues.push(Issue::new(
+                    "punch.electrode.charge",
+                    format!("{g} C/m is invalid; it must be finite"),
+                ));
+                None
+            }
+            (None, Some(v)) => {
+                issues.push(Issue::new(
+                    "punch.electrode.potential",
+                    format!("{v} V is invalid; it must be finite"),
+                ));
+                None
+            }
+            _ => {
+                issues.push(Issue::new(
+                    "punch.electrode",
+                    "a conducting punch is invalid without exactly one of `charge` (C/m) and `potential` (V)",
+                ));
+                None
+            }
+        },
+        (RawElectrode::Insulating {}, _) => Some(Electrode::Insulating),
+    }
+}
+
+/// A history checked before it is expanded: the expanded history (`None` when it would be too
+/// long), and its time span.
+pub(super) struct CheckedHistory {
+    pub(super) history: Option<crate::history::LoadHistory>,
+    pub(super) span: Option<(f64, f64)>,
+}
+
+/// Check a history's size from its segments, then expand and check it.
+pub(super) fn resolve_history(
+    issues: &mut Vec<Issue>,
+    h: &RawHistory,
+    friction: f64,
+    normal_load: f64,
+) -> CheckedHistory {
+    let limit = friction * normal_load;
+    let scale = match h.unit {
+        LoadUnit::FractionOfLimit => limit,
+        LoadUnit::NewtonPerMetre => 1.0,
+    };
+    let max_step = h.max_step.map_or(0.05 * limit, |m| m * scale);
+    if friction <= 0.0 {
+        issues.push(Issue::new(
+            "tangential_history",
+            "a history is invalid without friction; it must have `friction` > 0",
+        ));
+    }
+    let sized = limit.is_finite() && limit > 0.0 && h.steps_per_segment > 0;
+    let steps = if sized && max_step.is_finite() && max_step > 0.0 {
+        h.load_steps(scale, max_step)
+    } else {
+        // Each segment takes at least one step.
+        h.point_count() - 1.0
+    };
+    if steps > MAX_LOAD_STEPS as f64 {
+        issues.push(Issue::new(
+            "tangential_history",
+            format!(
+                "{} load steps ({} points, {} cycle points × {} repeats, steps_per_segment = {}, \
+                 max_step = {max_step:e} N/m) is invalid; it must be at most {MAX_LOAD_STEPS}",
+                count_text(steps),
+                h.points.len(),
+                h.cycle.len(),
+                h.repeats,
+                h.steps_per_segment
+            ),
+        ));
+        validate_cycle(issues, &h.cycle);
+        return CheckedHistory {
+            history: None,
+            span: h.span(),
+        };
+    }
+    let lead: Vec<(f64, f64)> = h.points.iter().map(|(t, q)| (*t, q * scale)).collect();
+    let cycle: Vec<(f64, f64)> = h.cycle.iter().map(|(t, q)| (*t, q * scale)).collect();
+    let repeats = if cycle.is_empty() { 0 } else { h.repeats };
+    let points = crate::history::LoadHistory::with_cycles(&lead, &cycle, repeats);
+    let history = crate::history::LoadHistory {
+        points,
+        steps_per_segment: h.steps_per_segment,
+        max_step,
+    };
+    if friction > 0.0 && limit.is_finite() && limit > 0.0 {
+        issues.extend(history.validate("tangential_history", limit));
+    }
+    validate_cycle(issues, &h.cycle);
+    let span = history
+        .points
+        .first()
+        .zip(history.points.last())
+        .map(|(a, b)| (a.0, b.0));
+    CheckedHistory {
+        history: Some(history),
+        span,
+    }
+}
+
+/// The cycle's times: strictly increasing and > 0.
+pub(super) fn validate_cycle(issues: &mut Vec<Issue>, cycle: &[(f64, f64)]) {
+    for (i, w) in cycle.windows(2).enumerate() {
+        if w[1].0 <= w[0].0 {
+            issues.push(Issue::new(
+                format!("tangential_history.cycle[{}].t", i + 1),
+                format!(
+                    "{} s is invalid; it must be > previous Δt = {} s",
+                    w[1].0, w[0].0
+                ),
+            ));
+        }
+    }
+    if let Some(first) = cycle.first()
+        && first.0 <= 0.0
+    {
+        issues.push(Issue::new(
+            "tangential_history.cycle[0].t",
+            format!("{} s is invalid; it must be > 0", first.0),
+        ));
+    }
+}
+
+/// A count held as f64: in full up to 1e12, else in exponent form.
+pub(super) fn count_text(n: f64) -> String {
+    if n < 1e12 {
+        format!("{n:.0}")
+    } else {
+        format!("{n:.3e}")
+    }
+}
+
+/// Steps of a `(ΔQ)` segment, as [`crate::history::LoadHistory::steps`] cuts it.
+pub(super) fn segment_steps(dq: f64, steps_per_segment: f64, max_step: f64) -> f64 {
+    if dq.abs() > 0.0 {
+        steps_per_segment.max((dq.abs() / max_step).ceil()).max(1.0)
+    } else {
+        1.0
+    }
+}
+
+/// Load steps of a run of an expanded history: the ramp to the first point and the segments.
+pub(super) fn load_step_count(h: &crate::history::LoadHistory) -> f64 {
+    let sps = h.steps_per_segment as f64;
+    let ramp = h
+        .points
+        .first()
+        .map_or(0.0, |&(_, q)| ramp_steps(q, sps, h.max_step));
+    ramp + h
+        .points
+        .windows(2)
+        .map(|w| segment_steps(w[1].1 - w[0].1, sps, h.max_step))
+        .sum::<f64>()
+}
+
+/// Steps of the ramp from Q = 0 to the first point `q` (as `history::run_history` takes them).
+pub(super) fn ramp_steps(q: f64, steps_per_segment: f64, max_step: f64) -> f64 {
+    if q.abs() > 0.0 {
+        steps_per_segment.max((q.abs() / max_step).ceil())
+    } else {
+        0.0
+    }
+}
+
+impl RawHistory {
+    /// Points after the cycle is repeated, counted without repeating it.
+    fn point_count(&self) -> f64 {
+        let repeats = if self.cycle.is_empty() {
+            0
+        } else {
+            self.repeats
+        };
+        self.points.len() as f64 + repeats as f64 * self.cycle.len() as f64
+    }
+
+    /// Load steps of a run (the ramp to the first point, the lead-in, each repeat of the
+    /// cycle), counted from the segments without repeating the cycle; `scale` turns Q into
+    /// N/m, `max_step` is in N/m.
+    pub(super) fn load_steps(&self, scale: f64, max_step: f64) -> f64 {
+        let sps = self.steps_per_segment as f64;
+        let steps = |q0: f64, q1: f64| segment_steps(q1 * scale - q0 * scale, sps, max_step);
+        let within =
+            |pts: &[(f64, f64)]| pts.windows(2).map(|w| steps(w[0].1, w[1].1)).sum::<f64>();
+        let repeats = if self.cycle.is_empty() {
+            0.0
+        } else {
+            self.repeats as f64
+        };
+        let first = self
+            .points
+            .first()
+            .or(self.cycle.first().filter(|_| repeats > 0.0));
+        let mut total = first.map_or(0.0, |p| ramp_steps(p.1 * scale, sps, max_step));
+        total += within(&self.points);
+        if let (Some(c0), Some(c1)) = (self.cycle.first(), self.cycle.last())
+            && repeats > 0.0
+        {
+            let cycle = within(&self.cycle);
+            let join = self.points.last().map_or(0.0, |p| steps(p.1, c0.1));
+            total += join + cycle + (repeats - 1.0) * (steps(c1.1, c0.1) + cycle);
+        }
+        total
+    }
+
+    /// The time span `[first t, last t]` of the expanded history, computed without expanding
+    /// it (to round-off: for checks of a history too long to expand).
+    fn span(&self) -> Option<(f64, f64)> {
+        let repeats = if self.cycle.is_empty() {
+            0.0
+        } else {
+            self.repeats as f64
+        };
+        let t_lead = self.points.last().map_or(0.0, |p| p.0);
+        let first = self.points.first().map(|p| p.0).or_else(|| {
+            self.cycle
+                .first()
+                .filter(|_| repeats > 0.0)
+                .map(|c| t_lead + c.0)
+        })?;
+        let last = self
+            .cycle
+            .last()
+            .filter(|_| repeats > 0.0)
+            .map_or(t_lead, |c| t_lead + repeats * c.0);
+        Some((first, last))
+    }
+}
+
+/// Check the output options; returns the time tolerance used to match snapshot times to steps
+/// (1e−9 of the history's largest time scale).
+pub(super) fn validate_output(
+    issues: &mut Vec<Issue>,
+    out: &RawOutput,
+    span: Option<(f64, f64)>,
+    has_history: bool,
+) -> f64 {
+    let n = out.field_points;
+    if !(16..=MAX_FIELD_POINTS).contains(&n) || !n.is_multiple_of(4) {
+        issues.push(Issue::new(
+            "output.field_points",
+            format!(
+                "{n} is invalid; it must be a multiple of 4 in [16, {MAX_FIELD_POINTS}] (so that no sample falls on a contact end)"
+            ),
+        ));
+    }
+    if out.snapshots.len() > MAX_SNAPSHOTS {
+        issues.push(Issue::new(
+            "output.snapshots",
+            format!(
+                "{} times is invalid; it must hold at most {MAX_SNAPSHOTS}",
+                out.snapshots.len()
+            ),
+        ));
+        return 0.0;
+    }
+    let Some((t0, t1)) = span.filter(|(a, b)| a.is_finite() && b.is_finite()) else {
+        if !has_history && !out.snapshots.is_empty() {
+            issues.push(Issue::new(
+                "output.snapshots",
+                "a list of times is invalid without a `tangential_history`; it must be [] or omitted \
+                 (the fields at the end of normal loading are always written to fields/normal_loading.csv)",
+            ));
+        }
+        return 0.0;
+    };
+    let tol = 1e-9 * t0.abs().max(t1.abs()).max(t1 - t0);
+    for (i, &t) in out.snapshots.iter().enumerate() {
+        let path = format!("output.snapshots[{i}]");
+        if !t.is_finite() {
+            issues.push(Issue::new(
+                path,
+                format!("{t} s is invalid; it must be finite"),
+            ));
+            continue;
+        }
+        if t < t0 - tol || t > t1 + tol {
+            issues.push(Issue::new(
+                path.clone(),
+                format!("{t} s is invalid; it must lie within the history's span [{t0}, {t1}] s"),
+            ));
+        }
+        if i > 0 {
+            let prev = out.snapshots[i - 1];
+            if prev.is_finite() && t <= prev {
+                issues.push(Issue::new(
+                    path,
+                    format!("{t} s is invalid; it must be > previous t = {prev} s"),
+                ));
+            } else if snapshot_stem(t) == snapshot_stem(prev) {
+                issues.push(Issue::new(
+                    path,
+                    format!(
+                        "{t} s is invalid; it must differ from the previous t = {prev} s in the first 6 decimals \
+                         (both would be written to fields/{}.csv)",
+                        snapshot_stem(t)
+                    ),
+                ));
+            }
+        }
+    }
+    tol
+}
