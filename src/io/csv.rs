@@ -1,133 +1,169 @@
-//! The CSV files of a run: `steps.csv`, `cycles.csv` and the field files. Headers carry the
-//! units; numbers are written as `%.10e`, counters as integers.
+//! The tables of a run: `steps.csv`, `cycles.csv` and the field files, each defined once as
+//! named columns ([`Table`]) that the CSV writer and the Python package both read. Headers carry
+//! the units; numbers are written as `%.10e`, counters as integers, a missing value as an empty
+//! field.
 
 use crate::analysis::CycleRow;
 use crate::contact::SurfacePoint;
-use crate::io::folder::csv_bytes;
+use crate::history::StepRecord;
 
-/// A fields CSV: `x_m, p_Pa, q_Pa, g_C_per_m2, sigma_xx_Pa, d_x_C_per_m2`.
-pub(crate) fn fields_csv(points: &[SurfacePoint]) -> Vec<u8> {
-    let rows: Vec<Vec<f64>> = points
-        .iter()
-        .map(|p| vec![p.x, p.pressure, p.traction, p.charge, p.sigma_xx, p.d_x])
-        .collect();
-    csv_bytes(
-        &[
-            "x_m",
-            "p_Pa",
-            "q_Pa",
-            "g_C_per_m2",
-            "sigma_xx_Pa",
-            "d_x_C_per_m2",
+/// One column's values.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Column {
+    /// Real numbers.
+    Real(Vec<f64>),
+    /// Real numbers that may be missing.
+    MaybeReal(Vec<Option<f64>>),
+    /// Counters.
+    Count(Vec<usize>),
+    /// Counters that may be missing.
+    MaybeCount(Vec<Option<usize>>),
+    /// Labels.
+    Text(Vec<String>),
+}
+
+impl Column {
+    fn len(&self) -> usize {
+        match self {
+            Column::Real(v) => v.len(),
+            Column::MaybeReal(v) => v.len(),
+            Column::Count(v) => v.len(),
+            Column::MaybeCount(v) => v.len(),
+            Column::Text(v) => v.len(),
+        }
+    }
+
+    fn cell(&self, row: usize) -> String {
+        let real = |x: f64| format!("{x:.10e}");
+        match self {
+            Column::Real(v) => real(v[row]),
+            Column::MaybeReal(v) => v[row].map(real).unwrap_or_default(),
+            Column::Count(v) => v[row].to_string(),
+            Column::MaybeCount(v) => v[row].map(|k| k.to_string()).unwrap_or_default(),
+            Column::Text(v) => v[row].clone(),
+        }
+    }
+}
+
+/// Named columns of equal length.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    /// `(name with unit, values)` in file order.
+    pub columns: Vec<(&'static str, Column)>,
+}
+
+impl Table {
+    /// The number of rows.
+    pub fn rows(&self) -> usize {
+        self.columns.first().map_or(0, |(_, c)| c.len())
+    }
+
+    /// The table as CSV with a header line.
+    pub fn csv(&self) -> Vec<u8> {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.write_record(self.columns.iter().map(|(name, _)| *name))
+            .expect("in-memory write");
+        for row in 0..self.rows() {
+            w.write_record(self.columns.iter().map(|(_, c)| c.cell(row)))
+                .expect("in-memory write");
+        }
+        w.into_inner().expect("in-memory write")
+    }
+}
+
+fn real<T>(items: &[T], f: impl Fn(&T) -> f64) -> Column {
+    Column::Real(items.iter().map(f).collect())
+}
+
+/// The fields of one instant: `x_m, p_Pa, q_Pa, g_C_per_m2, sigma_xx_Pa, d_x_C_per_m2`.
+pub fn fields_table(points: &[SurfacePoint]) -> Table {
+    Table {
+        columns: vec![
+            ("x_m", real(points, |p| p.x)),
+            ("p_Pa", real(points, |p| p.pressure)),
+            ("q_Pa", real(points, |p| p.traction)),
+            ("g_C_per_m2", real(points, |p| p.charge)),
+            ("sigma_xx_Pa", real(points, |p| p.sigma_xx)),
+            ("d_x_C_per_m2", real(points, |p| p.d_x)),
         ],
-        &rows,
-    )
+    }
 }
 
 /// `cycles.csv`: one row per fretting cycle.
-pub(crate) fn cycles_csv(cycles: &[CycleRow]) -> Vec<u8> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record([
-        "cycle",
-        "first_step",
-        "last_step",
-        "Q_start_N_per_m",
-        "Q_min_N_per_m",
-        "Q_end_N_per_m",
-        "loop_area_J_per_m",
-        "friction_work_J_per_m",
-        "normal_work_J_per_m",
-        "electric_work_J_per_m",
-        "delta_at_max_m",
-        "delta_at_min_m",
-        "stick_lo_at_max_m",
-        "stick_hi_at_max_m",
-        "stick_lo_at_min_m",
-        "stick_hi_at_min_m",
-        "change_vs_previous",
-        "compared_with_cycle",
-    ])
-    .expect("in-memory write");
-    let f = |x: f64| format!("{x:.10e}");
-    for c in cycles {
-        w.write_record([
-            c.cycle.to_string(),
-            c.steps.0.to_string(),
-            c.steps.1.to_string(),
-            f(c.loads.0),
-            f(c.loads.1),
-            f(c.loads.2),
-            f(c.loop_area),
-            f(c.friction_work),
-            f(c.normal_work),
-            f(c.electric_work),
-            f(c.displacement_extremes.0),
-            f(c.displacement_extremes.1),
-            f(c.stick_at_max.0),
-            f(c.stick_at_max.1),
-            f(c.stick_at_min.0),
-            f(c.stick_at_min.1),
-            c.change.map(f).unwrap_or_default(),
-            c.compared_with.map(|k| k.to_string()).unwrap_or_default(),
-        ])
-        .expect("in-memory write");
+pub fn cycles_table(cycles: &[CycleRow]) -> Table {
+    let c = cycles;
+    Table {
+        columns: vec![
+            ("cycle", Column::Count(c.iter().map(|c| c.cycle).collect())),
+            (
+                "first_step",
+                Column::Count(c.iter().map(|c| c.steps.0).collect()),
+            ),
+            (
+                "last_step",
+                Column::Count(c.iter().map(|c| c.steps.1).collect()),
+            ),
+            ("Q_start_N_per_m", real(c, |c| c.loads.0)),
+            ("Q_min_N_per_m", real(c, |c| c.loads.1)),
+            ("Q_end_N_per_m", real(c, |c| c.loads.2)),
+            ("loop_area_J_per_m", real(c, |c| c.loop_area)),
+            ("friction_work_J_per_m", real(c, |c| c.friction_work)),
+            ("normal_work_J_per_m", real(c, |c| c.normal_work)),
+            ("electric_work_J_per_m", real(c, |c| c.electric_work)),
+            ("delta_at_max_m", real(c, |c| c.displacement_extremes.0)),
+            ("delta_at_min_m", real(c, |c| c.displacement_extremes.1)),
+            ("stick_lo_at_max_m", real(c, |c| c.stick_at_max.0)),
+            ("stick_hi_at_max_m", real(c, |c| c.stick_at_max.1)),
+            ("stick_lo_at_min_m", real(c, |c| c.stick_at_min.0)),
+            ("stick_hi_at_min_m", real(c, |c| c.stick_at_min.1)),
+            (
+                "change_vs_previous",
+                Column::MaybeReal(c.iter().map(|c| c.change).collect()),
+            ),
+            (
+                "compared_with_cycle",
+                Column::MaybeCount(c.iter().map(|c| c.compared_with).collect()),
+            ),
+        ],
     }
-    w.into_inner().expect("in-memory write")
 }
 
-/// `steps.csv`: one row per accepted step.
-pub(crate) fn steps_csv(records: &[crate::history::StepRecord], limit: f64) -> Vec<u8> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record([
-        "step",
-        "t_s",
-        "Q_N_per_m",
-        "Q_over_etaP",
-        "regime",
-        "phase",
-        "a_m",
-        "e_m",
-        "stick_lo_m",
-        "stick_hi_m",
-        "left_slip_sign",
-        "right_slip_sign",
-        "newton_iterations",
-        "evaluations",
-        "residual",
-        "stick_excess",
-        "slip_reversal",
-        "delta_m",
-        "dissipation_J_per_m",
-    ])
-    .expect("in-memory write");
-    for r in records {
-        let regime = serde_json::to_value(r.regime)
+/// `steps.csv`: one row per accepted step; `limit` is ηP (N/m).
+pub fn steps_table(records: &[StepRecord], limit: f64) -> Table {
+    let r = records;
+    let regime = |r: &StepRecord| {
+        serde_json::to_value(r.regime)
             .ok()
             .and_then(|v| v.as_str().map(String::from))
-            .unwrap_or_default();
-        let f = |x: f64| format!("{x:.10e}");
-        w.write_record([
-            r.step.to_string(),
-            f(r.t),
-            f(r.q),
-            f(r.q / limit),
-            regime,
-            r.phase.to_string(),
-            f(r.half_width),
-            f(r.eccentricity),
-            f(r.stick_lo),
-            f(r.stick_hi),
-            f(r.left_slip_sign),
-            f(r.right_slip_sign),
-            r.iterations.to_string(),
-            r.newton_iterations.to_string(),
-            f(r.residual),
-            f(r.admissibility.stick_excess),
-            f(r.admissibility.slip_reversal),
-            f(r.displacement),
-            f(r.dissipation),
-        ])
-        .expect("in-memory write");
+            .unwrap_or_default()
+    };
+    Table {
+        columns: vec![
+            ("step", Column::Count(r.iter().map(|r| r.step).collect())),
+            ("t_s", real(r, |r| r.t)),
+            ("Q_N_per_m", real(r, |r| r.q)),
+            ("Q_over_etaP", real(r, |r| r.q / limit)),
+            ("regime", Column::Text(r.iter().map(regime).collect())),
+            ("phase", Column::Count(r.iter().map(|r| r.phase).collect())),
+            ("a_m", real(r, |r| r.half_width)),
+            ("e_m", real(r, |r| r.eccentricity)),
+            ("stick_lo_m", real(r, |r| r.stick_lo)),
+            ("stick_hi_m", real(r, |r| r.stick_hi)),
+            ("left_slip_sign", real(r, |r| r.left_slip_sign)),
+            ("right_slip_sign", real(r, |r| r.right_slip_sign)),
+            (
+                "newton_iterations",
+                Column::Count(r.iter().map(|r| r.iterations).collect()),
+            ),
+            (
+                "evaluations",
+                Column::Count(r.iter().map(|r| r.newton_iterations).collect()),
+            ),
+            ("residual", real(r, |r| r.residual)),
+            ("stick_excess", real(r, |r| r.admissibility.stick_excess)),
+            ("slip_reversal", real(r, |r| r.admissibility.slip_reversal)),
+            ("delta_m", real(r, |r| r.displacement)),
+            ("dissipation_J_per_m", real(r, |r| r.dissipation)),
+        ],
     }
-    w.into_inner().expect("in-memory write")
 }

@@ -505,17 +505,6 @@ impl SweepFolder {
     }
 }
 
-/// Serialise rows as CSV with a header line.
-pub fn csv_bytes(header: &[&str], rows: &[Vec<f64>]) -> Vec<u8> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(header).expect("in-memory write");
-    for row in rows {
-        w.write_record(row.iter().map(|v| format!("{v:.10e}")))
-            .expect("in-memory write");
-    }
-    w.into_inner().expect("in-memory write")
-}
-
 /// Write one file of a claimed folder atomically (a temporary file beside it, then a rename),
 /// creating its folder.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {

@@ -10,7 +10,7 @@ use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
 use crate::error::Error;
 use crate::history::StepRecord;
-use crate::io::csv::{cycles_csv, fields_csv, steps_csv};
+use crate::io::csv::{cycles_table, fields_table, steps_table};
 use crate::io::folder::{Protected, RunFolder};
 use crate::io::plots::{family_plots, history_plots, index_html, normal_loading_plots};
 use crate::io::summary::{
@@ -370,11 +370,14 @@ pub(crate) fn write_solution(
             &serde_json::to_vec_pretty(summary).expect("summary serialises"),
         )?;
         if scenario.history.is_some() {
-            put("steps.csv".into(), &steps_csv(records, limit))?;
-            put("cycles.csv".into(), &cycles_csv(cycles))?;
+            put("steps.csv".into(), &steps_table(records, limit).csv())?;
+            put("cycles.csv".into(), &cycles_table(cycles).csv())?;
         }
         for set in fields.iter().chain(turning_fields) {
-            put(format!("fields/{}.csv", set.stem), &fields_csv(&set.points))?;
+            put(
+                format!("fields/{}.csv", set.stem),
+                &fields_table(&set.points).csv(),
+            )?;
         }
         let mut section = |title: &str, plots: Vec<(String, String)>| -> Result<(), Error> {
             let mut names = Vec::new();
