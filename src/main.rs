@@ -121,7 +121,7 @@ fn run(path: Option<PathBuf>, out: Option<PathBuf>, quiet: bool) -> Result<(), E
             return Err(e);
         }
     };
-    let n = &result.summary.normal_loading;
+    let n = &result.solution.summary.normal_loading;
     println!(
         "{}: a = {:.6e} m, b/a = {:.6}, C = {:.6e} 1/m, p0 = {:.6e} Pa -> {}",
         sc.name,
@@ -131,7 +131,7 @@ fn run(path: Option<PathBuf>, out: Option<PathBuf>, quiet: bool) -> Result<(), E
         n.peak_pressure,
         result.out_dir.display()
     );
-    for w in &result.summary.warnings {
+    for w in &result.solution.summary.warnings {
         eprintln!("fretsim: warning: {w}");
     }
     Ok(())

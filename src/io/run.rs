@@ -23,10 +23,9 @@ use crate::scenario::Scenario;
 pub struct RunResult {
     /// Output folder.
     pub out_dir: PathBuf,
-    /// Summary (as written).
-    pub summary: Summary,
-    /// The sampled fields: the end of normal loading, then one set per snapshot time.
-    pub fields: Vec<FieldSet>,
+    /// What was solved and written; a history that stopped part-way has its failure in
+    /// [`Solution::failure`].
+    pub solution: Solution,
 }
 
 /// Everything a run computes, before anything is written: what [`solve`] returns and what
@@ -119,33 +118,27 @@ pub fn run_with(
     folder: RunFolder,
     observer: &mut dyn crate::history::Observer,
 ) -> Result<RunResult, Error> {
-    match run_partial(scenario, folder, observer)? {
-        (result, None) => Ok(result),
-        (_, Some(failure)) => Err(failure),
+    let mut result = run_partial(scenario, folder, observer)?;
+    match result.solution.failure.take() {
+        None => Ok(result),
+        Some(failure) => Err(failure),
     }
 }
 
-/// As [`run_with`], but a solver failure during the history is returned beside what was
-/// written (the summary and the fields reached) instead of replacing it. A failure of the
-/// normal loading is returned as `Err` after `failure.json` is written; so is a write error.
+/// As [`run_with`], but a solver failure during the history stays in the result's
+/// [`Solution::failure`], beside what was written (the summary and the fields reached). A
+/// failure of the normal loading is returned as `Err` after `failure.json` is written; so is
+/// a write error.
 pub fn run_partial(
     scenario: &Scenario,
     mut folder: RunFolder,
     observer: &mut dyn crate::history::Observer,
-) -> Result<(RunResult, Option<Error>), Error> {
+) -> Result<RunResult, Error> {
     crate::io::folder::pause_point("solve");
     match solve(scenario, observer) {
-        Ok(mut solution) => {
+        Ok(solution) => {
             let out_dir = write_solution(folder, scenario, &solution)?;
-            let failure = solution.failure.take();
-            Ok((
-                RunResult {
-                    out_dir,
-                    summary: solution.summary,
-                    fields: solution.fields,
-                },
-                failure,
-            ))
+            Ok(RunResult { out_dir, solution })
         }
         Err(error) => {
             folder.write("failure.json", &failure_json(&error, None))?;

@@ -413,10 +413,10 @@ pub fn sweep(
                 match claimed.and_then(|f| run_partial(sc, f, &mut crate::history::NoObserver)) {
                     // A history that stops part-way keeps its normal loading and the fields
                     // reached.
-                    Ok((r, error)) => VariantOutcome {
-                        normal: Some(r.summary.normal_loading),
-                        error,
-                        fields: r.fields,
+                    Ok(r) => VariantOutcome {
+                        normal: Some(r.solution.summary.normal_loading),
+                        error: r.solution.failure,
+                        fields: r.solution.fields,
                     },
                     Err(e) => VariantOutcome {
                         normal: None,

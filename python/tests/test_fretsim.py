@@ -1,0 +1,126 @@
+"""The Python package against the command line and against closed forms."""
+
+import csv
+import json
+import math
+import os
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import fretsim
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SCENARIOS = ROOT / "scenarios"
+BINARY = pathlib.Path(os.environ.get("FRETSIM_BIN", ROOT / "target" / "release" / "fretsim"))
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], rows[1:]
+
+
+def test_steps_and_fields_equal_the_command_lines_files(tmp_path):
+    """The same scenario through `fretsim run` and `fretsim.run`: every numeric column of
+    steps.csv and of a field file agrees to the files' 10 digits."""
+    assert BINARY.exists(), f"build the command first (cargo build --release): {BINARY}"
+    scenario = SCENARIOS / "figure3_history.json"
+    out = tmp_path / "cli"
+    subprocess.run([BINARY, "run", scenario, "--out", out, "--quiet"], check=True)
+    result = fretsim.run(scenario)
+    header, rows = read_csv(out / "steps.csv")
+    assert list(result.steps) == header
+    for k, name in enumerate(header):
+        column = [r[k] for r in rows]
+        if name == "regime":
+            assert list(result.steps[name]) == column
+        else:
+            np.testing.assert_allclose(result.steps[name], np.array(column, float), rtol=1e-9)
+    header, rows = read_csv(out / "fields" / "t_2.000000.csv")
+    for k, name in enumerate(header):
+        np.testing.assert_allclose(
+            result.fields["t_2.000000"][name], np.array([r[k] for r in rows], float), rtol=1e-9
+        )
+    summary = json.loads((out / "summary.json").read_text())
+    assert result.summary["history"]["verdict"] == summary["history"]["verdict"]
+
+
+def test_cattaneo_mindlin_stick_zone_at_the_first_peak():
+    """Uncoupled elastic contact (ν = 0.5): at the first peak Q = 0.6 ηP the stick zone is
+    |x − c| ≤ a √(1 − Q/(ηP)) (Cattaneo–Mindlin)."""
+    result = fretsim.run(SCENARIOS / "cattaneo_mindlin_uncoupled.json")
+    steps = result.steps
+    k = int(np.argmin(np.abs(steps["t_s"] - 1.0)))
+    assert steps["Q_over_etaP"][k] == pytest.approx(0.6, abs=1e-12)
+    a = steps["a_m"][k]
+    half = 0.5 * (steps["stick_hi_m"][k] - steps["stick_lo_m"][k])
+    assert half / a == pytest.approx(math.sqrt(1.0 - 0.6), abs=1e-8)
+
+
+def test_bad_input_raises_scenario_error_naming_the_field():
+    bad = fretsim.default_scenario()
+    bad["friction"] = -1.0
+    bad["punch"]["radius"] = 0.0
+    with pytest.raises(fretsim.ScenarioError) as caught:
+        fretsim.validate(bad)
+    message, issues = caught.value.args
+    assert {path for path, _ in issues} >= {"friction", "punch.radius"}
+    assert "must be" in message
+    with pytest.raises(fretsim.ScenarioError) as caught:
+        fretsim.run({"friction": "high"})
+    assert caught.value.args[1][0][0] == "friction"
+
+
+def test_validate_fills_in_the_defaults():
+    scenario = json.loads((SCENARIOS / "baseline.json").read_text())
+    full = fretsim.validate(scenario)
+    assert full["numerics"]["collocation_points"] > 0
+    assert full["friction"] == scenario["friction"]
+
+
+def test_out_writes_the_run_folder_and_never_a_users_folder(tmp_path):
+    out = tmp_path / "run"
+    result = fretsim.run(SCENARIOS / "baseline.json", out=out)
+    manifest = json.loads((out / "fretsim-manifest.json").read_text())
+    assert "summary.json" in manifest["files"]
+    assert result.verdict is None
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("keep")
+    with pytest.raises(fretsim.OutputError, match="not a fretsim output"):
+        fretsim.run(SCENARIOS / "baseline.json", out=mine)
+    assert (mine / "notes.txt").read_text() == "keep"
+
+
+def test_a_failed_normal_loading_raises_solve_error():
+    """PZT-4 at η = 0.1 with Γ = 2e−7 C/m: no state with one central stick zone exists."""
+    scenario = json.loads((SCENARIOS / "baseline.json").read_text())
+    scenario["friction"] = 0.1
+    scenario["punch"]["electrode"]["charge"] = 2e-7
+    with pytest.raises(fretsim.SolveError, match="normal loading"):
+        fretsim.run(scenario)
+
+
+def test_run_many_keeps_the_order_and_returns_the_errors():
+    base = json.loads((SCENARIOS / "baseline.json").read_text())
+    etas = [0.2, 0.3, 0.4]
+    scenarios = [dict(base, friction=eta) for eta in etas] + [dict(base, friction=-1.0)]
+    results = fretsim.run_many(scenarios)
+    ratios = [r.summary["normal_loading"]["stick_ratio"] for r in results[:3]]
+    assert ratios == sorted(ratios), "b/a rises with η (the paper's Figure 8)"
+    one = fretsim.run(scenarios[1])
+    assert ratios[1] == one.summary["normal_loading"]["stick_ratio"]
+    assert isinstance(results[3], fretsim.ScenarioError)
+
+
+def test_the_tutorial_runs(tmp_path):
+    pytest.importorskip("matplotlib")
+    figure = tmp_path / "figure8.png"
+    script = ROOT / "python" / "examples" / "figure8_stick_ratio.py"
+    done = subprocess.run([sys.executable, script, figure], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert figure.stat().st_size > 10_000
