@@ -21,6 +21,12 @@
 //! manifest of kind `sweep`, each shard replaces its own CSV file atomically, and every
 //! variant's folder inside it is claimed as a run folder of its own.
 
+#[cfg(not(any(target_os = "linux", target_os = "macos")))]
+compile_error!(
+    "fretsim's output folders need an atomic exchange of two folders and an advisory lock: \
+     renameat2 (Linux) or renameatx_np (macOS) and flock"
+);
+
 use std::fs;
 use std::io::Write;
 use std::path::{Component, Path, PathBuf};
