@@ -31,11 +31,11 @@
 //! writes the output folder that `fretsim run` writes.
 //!
 //! ```
-//! use fretsim::{history::NoObserver, io, scenario};
+//! use fretsim::history::NoObserver;
 //!
 //! // The built-in scenario: PZT-4, conducting punch, P = 2000 N/m, three cycles of ±0.5 ηP.
-//! let scenario = scenario::default_scenario();
-//! let solution = io::solve(&scenario, &mut NoObserver).expect("the default scenario solves");
+//! let scenario = fretsim::default_scenario();
+//! let solution = fretsim::solve(&scenario, &mut NoObserver).expect("the default scenario solves");
 //! let normal = &solution.summary.normal_loading;
 //! assert!((normal.pressure_resultant - 2000.0).abs() < 1e-6); // ∫p dx = P
 //! assert!(normal.stick_ratio > 0.0 && normal.stick_ratio < 1.0); // slip zones at both ends
@@ -84,3 +84,11 @@ pub mod material;
 pub mod quadrature;
 pub mod scenario;
 pub mod transforms;
+
+// The entry points most programs need, at the crate root.
+pub use analysis::Verdict;
+pub use contact::{ContactModel, Coupling, Electrode, Profile};
+pub use error::{Error, Issue, SolveFailure};
+pub use io::{RunResult, Solution, run, solve};
+pub use material::{Material, PiezoConstants};
+pub use scenario::{Scenario, default_scenario, load, parse, validate};
