@@ -60,9 +60,12 @@ fn tick_label(v: f64, step: f64) -> String {
 }
 
 /// A line plot as an SVG document: axes with ticks, labels (units in the labels), and a legend
-/// to the right of the plot area (series with an empty label are not listed).
+/// to the right of the plot area when more than one series is labelled (series with an empty
+/// label are not listed; a single curve is named by the axis label and the title).
 pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series<'_>]) -> String {
-    let (w, h, left, right, top, bottom) = (960.0, 440.0, 90.0, 250.0, 40.0, 60.0);
+    let legend = series.iter().filter(|s| !s.label.is_empty()).count() > 1;
+    let right = if legend { 250.0 } else { 40.0 };
+    let (w, h, left, top, bottom) = (960.0, 440.0, 90.0, 40.0, 60.0);
     let (title, x_label, y_label) = (escape(title), escape(x_label), escape(y_label));
     let pts = series
         .iter()
@@ -179,7 +182,7 @@ pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series<'_>
             s.colour,
             path.join(" ")
         );
-        if s.label.is_empty() {
+        if !legend || s.label.is_empty() {
             continue;
         }
         let ly = top + 8.0 + 18.0 * legend_row as f64;
@@ -233,25 +236,26 @@ mod tests {
     }
 
     #[test]
-    fn text_is_escaped_and_unlabelled_series_have_no_legend_entry() {
-        let s = [
-            Series {
-                label: "p < q & r",
-                points: vec![(0.0, 0.0), (1.0, 1.0)],
-                colour: "black",
-            },
-            Series {
-                label: "",
-                points: vec![(0.0, 1.0), (1.0, 0.0)],
-                colour: "gray",
-            },
-        ];
-        let svg = line_plot("a & b", "x (m)", "p (Pa)", &s);
+    fn text_is_escaped_and_a_legend_lists_the_labelled_series_when_there_are_several() {
+        let series = |labels: &[&'static str]| -> Vec<Series<'static>> {
+            labels
+                .iter()
+                .enumerate()
+                .map(|(k, label)| Series {
+                    label,
+                    points: vec![(0.0, k as f64), (1.0, 1.0 - k as f64)],
+                    colour: "black",
+                })
+                .collect()
+        };
+        let entries =
+            |svg: &str| svg.matches("<line x1=").count() - svg.matches("stroke=\"#ddd\"").count();
+        let svg = line_plot("a & b", "x (m)", "p (Pa)", &series(&["p < q & r", "", "s"]));
         assert!(svg.contains("p &lt; q &amp; r") && svg.contains("a &amp; b"));
+        assert_eq!(svg.matches("<polyline").count(), 3);
+        assert_eq!(entries(&svg), 2);
+        let svg = line_plot("one", "x (m)", "p (Pa)", &series(&["p", ""]));
         assert_eq!(svg.matches("<polyline").count(), 2);
-        assert_eq!(
-            svg.matches("<line x1=").count() - svg.matches("stroke=\"#ddd\"").count(),
-            1
-        );
+        assert_eq!(entries(&svg), 0, "a single labelled curve has no legend");
     }
 }
