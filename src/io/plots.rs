@@ -2,69 +2,162 @@
 
 use crate::contact::SurfacePoint;
 
-/// The plots of the fields at the end of normal loading.
-pub(crate) fn normal_loading_plots(points: &[SurfacePoint]) -> Vec<(String, String)> {
+/// How the field plots are scaled: by the end of normal loading's contact half-width a, peak
+/// pressure p0, ηp0 (p0 without friction) and g0 = k·p0, the charge density that the pressure
+/// carries at its peak under a conducting punch (Γ1 = kP); or in SI units. A quantity whose
+/// scale is zero (no charge on an elastic half-plane) stays in SI.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlotScales {
+    /// a (m); 0 for SI.
+    pub length: f64,
+    /// p0 (Pa).
+    pub pressure: f64,
+    /// ηp0 (Pa).
+    pub shear: f64,
+    /// g0 = k·p0 (C/m²).
+    pub charge: f64,
+}
+
+impl PlotScales {
+    /// Every axis in SI units.
+    pub const SI: Self = Self {
+        length: 0.0,
+        pressure: 0.0,
+        shear: 0.0,
+        charge: 0.0,
+    };
+
+    /// The scales of a contact whose normal loading ended with half-width `a`, peak pressure
+    /// `p0`, friction `eta` and charge per force `k` (C/N).
+    pub fn normalised(a: f64, p0: f64, eta: f64, k: f64) -> Self {
+        Self {
+            length: a,
+            pressure: p0,
+            shear: if eta > 0.0 { eta * p0 } else { p0 },
+            charge: (k * p0).abs(),
+        }
+    }
+
+    /// `(x value, axis label)` for a length in m.
+    fn x(&self) -> (f64, String) {
+        scaled(self.length, "x/a", "x (m)", "a", "m")
+    }
+}
+
+/// The divisor and axis label of a quantity: `name (unit)` in SI, or `ratio (symbol = value
+/// unit)` when the scale is positive.
+fn scaled(scale: f64, ratio: &str, si: &str, symbol: &str, unit: &str) -> (f64, String) {
+    if scale > 0.0 && scale.is_finite() {
+        (scale, format!("{ratio} ({symbol} = {scale:.4e} {unit})"))
+    } else {
+        (1.0, si.to_string())
+    }
+}
+
+type Quantity = (
+    &'static str,
+    &'static str,
+    fn(&SurfacePoint) -> f64,
+    fn(&PlotScales) -> (f64, String),
+);
+
+/// The field quantities: key, title, value, and scale with its axis label.
+const QUANTITIES: [Quantity; 5] = [
+    (
+        "p",
+        "Pressure p",
+        |p| p.pressure,
+        |s| scaled(s.pressure, "p/p0", "p (Pa)", "p0", "Pa"),
+    ),
+    (
+        "q",
+        "Shear traction q (on the half-plane)",
+        |p| p.traction,
+        |s| scaled(s.shear, "q/(ηp0)", "q (Pa)", "ηp0", "Pa"),
+    ),
+    (
+        "g",
+        "Surface charge g",
+        |p| p.charge,
+        |s| scaled(s.charge, "g/g0", "g (C/m²)", "g0 = kp0", "C/m²"),
+    ),
+    (
+        "sigma_xx",
+        "Surface stress σxx0",
+        |p| p.sigma_xx,
+        |s| scaled(s.pressure, "σxx0/p0", "σxx0 (Pa)", "p0", "Pa"),
+    ),
+    (
+        "d_x",
+        "In-plane electric displacement Dx0",
+        |p| p.d_x,
+        |s| scaled(s.charge, "Dx0/g0", "Dx0 (C/m²)", "g0 = kp0", "C/m²"),
+    ),
+];
+
+/// The plots of the fields at the end of normal loading: p and q together, then g, σxx0 and
+/// Dx0.
+pub(crate) fn normal_loading_plots(
+    points: &[SurfacePoint],
+    scales: &PlotScales,
+) -> Vec<(String, String)> {
     use crate::io::svg::{Series, line_plot};
-    let field =
-        |f: &dyn Fn(&SurfacePoint) -> f64| points.iter().map(|p| (p.x, f(p))).collect::<Vec<_>>();
-    let one = |name: &str, title: &str, y: &str, label: &str, f: &dyn Fn(&SurfacePoint) -> f64| {
-        (
+    let (x_scale, x_label) = scales.x();
+    let field = |f: fn(&SurfacePoint) -> f64, scale: f64| {
+        points
+            .iter()
+            .map(|p| (p.x / x_scale, f(p) / scale))
+            .collect::<Vec<_>>()
+    };
+    let [p, q, rest @ ..] = &QUANTITIES;
+    let (p_scale, p_label) = (p.3)(scales);
+    // p and q on one axis: q in the pressure's scale.
+    let tractions_label =
+        p_label
+            .replacen("p/p0", "p/p0, q/p0", 1)
+            .replacen("p (Pa)", "p, q (Pa)", 1);
+    let mut plots = vec![(
+        "normal_loading_tractions".to_string(),
+        line_plot(
+            "End of normal loading: pressure p and shear traction q",
+            &x_label,
+            &tractions_label,
+            &[
+                Series {
+                    label: "p",
+                    points: field(p.2, p_scale),
+                    colour: "black",
+                },
+                Series {
+                    label: "q (on the half-plane)",
+                    points: field(q.2, p_scale),
+                    colour: "crimson",
+                },
+            ],
+        ),
+    )];
+    let names = [
+        "normal_loading_charge",
+        "normal_loading_sigma_xx",
+        "normal_loading_d_x",
+    ];
+    for ((_, title, f, scale), name) in rest.iter().zip(names) {
+        let (s, label) = scale(scales);
+        plots.push((
             name.to_string(),
             line_plot(
-                &format!("End of normal loading: {title}"),
-                "x (m)",
-                y,
+                &format!("End of normal loading: {}", title.to_lowercase()),
+                &x_label,
+                &label,
                 &[Series {
-                    label,
-                    points: field(f),
+                    label: "",
+                    points: field(*f, s),
                     colour: "black",
                 }],
             ),
-        )
-    };
-    vec![
-        (
-            "normal_loading_tractions".into(),
-            line_plot(
-                "End of normal loading: pressure p and shear traction q",
-                "x (m)",
-                "p, q (Pa)",
-                &[
-                    Series {
-                        label: "p",
-                        points: field(&|p| p.pressure),
-                        colour: "black",
-                    },
-                    Series {
-                        label: "q (on the half-plane)",
-                        points: field(&|p| p.traction),
-                        colour: "crimson",
-                    },
-                ],
-            ),
-        ),
-        one(
-            "normal_loading_charge",
-            "surface charge g",
-            "g (C/m²)",
-            "g",
-            &|p| p.charge,
-        ),
-        one(
-            "normal_loading_sigma_xx",
-            "surface stress σxx0",
-            "σxx0 (Pa)",
-            "σxx0",
-            &|p| p.sigma_xx,
-        ),
-        one(
-            "normal_loading_d_x",
-            "in-plane electric displacement Dx0",
-            "Dx0 (C/m²)",
-            "Dx0",
-            &|p| p.d_x,
-        ),
-    ]
+        ));
+    }
+    plots
 }
 
 /// One plot per field quantity (p, q, g, σxx0, Dx0) with one curve per member of a family
@@ -74,48 +167,29 @@ pub fn family_plots(
     prefix: &str,
     what: &str,
     family: &[(&str, &[SurfacePoint])],
+    scales: &PlotScales,
 ) -> Vec<(String, String)> {
     use crate::io::svg::{PALETTE, Series, line_plot};
     if family.is_empty() {
         return Vec::new();
     }
-    type Quantity = (
-        &'static str,
-        &'static str,
-        &'static str,
-        fn(&SurfacePoint) -> f64,
-    );
-    let quantities: [Quantity; 5] = [
-        ("p", "Pressure p", "p (Pa)", |p| p.pressure),
-        ("q", "Shear traction q (on the half-plane)", "q (Pa)", |p| {
-            p.traction
-        }),
-        ("g", "Surface charge g", "g (C/m²)", |p| p.charge),
-        ("sigma_xx", "Surface stress σxx0", "σxx0 (Pa)", |p| {
-            p.sigma_xx
-        }),
-        (
-            "d_x",
-            "In-plane electric displacement Dx0",
-            "Dx0 (C/m²)",
-            |p| p.d_x,
-        ),
-    ];
-    quantities
+    let (x_scale, x_label) = scales.x();
+    QUANTITIES
         .iter()
-        .map(|(key, title, y, f)| {
+        .map(|(key, title, f, scale)| {
+            let (s, y_label) = scale(scales);
             let series: Vec<Series> = family
                 .iter()
                 .enumerate()
                 .map(|(k, (label, points))| Series {
                     label,
-                    points: points.iter().map(|p| (p.x, f(p))).collect(),
+                    points: points.iter().map(|p| (p.x / x_scale, f(p) / s)).collect(),
                     colour: PALETTE[k % PALETTE.len()],
                 })
                 .collect();
             (
                 format!("{prefix}_{key}"),
-                line_plot(&format!("{title} {what}"), "x (m)", y, &series),
+                line_plot(&format!("{title} {what}"), &x_label, &y_label, &series),
             )
         })
         .collect()

@@ -12,7 +12,7 @@ use crate::error::Error;
 use crate::history::StepRecord;
 use crate::io::csv::{cycles_table, fields_table, steps_table};
 use crate::io::folder::{Protected, RunFolder};
-use crate::io::plots::{family_plots, history_plots, index_html, normal_loading_plots};
+use crate::io::plots::{PlotScales, family_plots, history_plots, index_html, normal_loading_plots};
 use crate::io::summary::{
     Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary, solver_statistics,
 };
@@ -355,6 +355,7 @@ pub(crate) fn write_solution(
         failure,
     } = solution;
     let limit = scenario.model.friction * scenario.normal_load;
+    let scales = plot_scales(scenario, summary);
     let mut sections = Vec::new();
     {
         let mut put = |name: String, bytes: &[u8]| folder.write(&name, bytes);
@@ -385,7 +386,7 @@ pub(crate) fn write_solution(
         };
         section(
             "End of normal loading",
-            normal_loading_plots(&fields[0].points),
+            normal_loading_plots(&fields[0].points, &scales),
         )?;
         section(
             "Load history",
@@ -397,7 +398,7 @@ pub(crate) fn write_solution(
             .collect();
         section(
             "Fields at the snapshot instants",
-            family_plots("snapshots", "at the snapshot instants", &instants),
+            family_plots("snapshots", "at the snapshot instants", &instants, &scales),
         )?;
     }
     if let Some(e) = failure {
@@ -410,6 +411,20 @@ pub(crate) fn write_solution(
         index_html(&scenario.name, &sections, &written).as_bytes(),
     )?;
     folder.commit()
+}
+
+/// The field plots' scales: the end of normal loading's, unless the scenario asks for SI.
+fn plot_scales(scenario: &Scenario, summary: &Summary) -> PlotScales {
+    let n = &summary.normal_loading;
+    match scenario.raw.output.plot_units {
+        crate::scenario::PlotUnits::Si => PlotScales::SI,
+        crate::scenario::PlotUnits::Normalised => PlotScales::normalised(
+            n.half_width,
+            n.peak_pressure,
+            scenario.model.friction,
+            n.pressure_charge / scenario.normal_load,
+        ),
+    }
 }
 
 /// `failure.json`: the error and the last accepted step (none when normal loading failed).

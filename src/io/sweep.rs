@@ -9,7 +9,7 @@ use crate::contact::normal::{NormalOptions, solve_normal};
 use crate::contact::pressure::Discretisation;
 use crate::error::Error;
 use crate::io::folder::{Protected, RunFolder, SweepFolder};
-use crate::io::plots::{family_plots, index_html};
+use crate::io::plots::{PlotScales, family_plots, index_html};
 use crate::io::run::{FieldSet, run_partial};
 use crate::io::summary::{NormalSummary, normal_summary};
 use crate::scenario::Scenario;
@@ -558,7 +558,8 @@ pub(crate) fn write_comparison(
             }
             _ => "at the end of normal loading".to_string(),
         };
-        let plots = family_plots(&format!("compare_{stem}"), &what, &family);
+        // Variants differ in a and p0: their fields are compared in SI units.
+        let plots = family_plots(&format!("compare_{stem}"), &what, &family, &PlotScales::SI);
         let mut names = Vec::new();
         for (name, svg) in plots {
             crate::io::folder::write_atomic(

@@ -52,6 +52,21 @@ pub struct RawOutput {
     /// Sample points per field file (a multiple of 4 in [16, 100000], default 400).
     #[serde(default = "default_field_points")]
     pub field_points: usize,
+    /// Axes of the field plots: `normalised` (x/a, p/p0, q/(ηp0), g/g0, by the end of normal
+    /// loading; the default) or `si`.
+    #[serde(default)]
+    pub plot_units: PlotUnits,
+}
+
+/// Axes of the field plots.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlotUnits {
+    /// x/a, p/p0, q/(ηp0), g/g0 and the like, scaled by the end of normal loading.
+    #[default]
+    Normalised,
+    /// SI units.
+    Si,
 }
 
 impl Default for RawOutput {
@@ -60,6 +75,7 @@ impl Default for RawOutput {
             snapshots: Vec::new(),
             turning_point_fields: true,
             field_points: default_field_points(),
+            plot_units: PlotUnits::default(),
         }
     }
 }
