@@ -29,14 +29,15 @@ pub fn sign_pair(i: usize, j: usize, wi: f64, wj: f64) -> f64 {
     }
 }
 
-/// The Galerkin matrices of a mesh: `log[i, j] = ∫_{e_i}∫_{e_j} ln(|x − s|/d)` (symmetric) and
-/// `sign[i, j] = ∫_{e_i}∫_{e_j} sign(x − s)` (antisymmetric).
+/// The Galerkin matrices of a mesh: `log[i, j] = ∫_{e_i}∫_{e_j} ln(|x − s|/d)` (symmetric),
+/// stored, and `sign[i, j] = ∫_{e_i}∫_{e_j} sign(x − s)` (antisymmetric), applied in O(N) by
+/// [`sign_pair`]'s structure.
 #[derive(Debug, Clone)]
 pub struct Influence {
     /// The logarithmic kernel (m²).
     pub log: Mat<f64>,
-    /// The sign kernel (m²).
-    pub sign: Mat<f64>,
+    /// Element widths (m).
+    pub widths: Vec<f64>,
 }
 
 impl Influence {
@@ -53,16 +54,31 @@ impl Influence {
                 log[(j, i)] = v;
             }
         }
-        let sign = Mat::<f64>::from_fn(n, n, |i, j| sign_pair(i, j, w[i], w[j]));
-        Self { log, sign }
+        Self { log, widths: w }
     }
 
-    /// `out = M v` for one of the matrices.
-    pub fn apply(m: &Mat<f64>, v: &[f64], out: &mut [f64]) {
+    /// `out = log · v` (by columns: the matrix is symmetric).
+    pub fn log_apply(&self, v: &[f64], out: &mut [f64]) {
         for (i, o) in out.iter_mut().enumerate() {
-            *o = (0..v.len()).map(|j| m[(i, j)] * v[j]).sum();
+            *o = dot(self.log.col_as_slice(i), v);
         }
     }
+
+    /// `out = sign · v`: `out_i = w_i (Σ_{j<i} w_j v_j − Σ_{j>i} w_j v_j)`.
+    pub fn sign_apply(&self, v: &[f64], out: &mut [f64]) {
+        let total: f64 = v.iter().zip(&self.widths).map(|(v, w)| v * w).sum();
+        let mut below = 0.0;
+        for (i, o) in out.iter_mut().enumerate() {
+            let own = v[i] * self.widths[i];
+            *o = self.widths[i] * (below - (total - below - own));
+            below += own;
+        }
+    }
+}
+
+/// `Σ a_i b_i`.
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
 }
 
 /// `∫_{x1}^{x2} x²/(2R) dx`: the element integral of the punch profile.
@@ -73,6 +89,27 @@ pub fn profile_integral(x1: f64, x2: f64, radius: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The O(N) sign product against the matrix of [`sign_pair`].
+    #[test]
+    fn sign_apply_matches_the_matrix() {
+        let mesh = Mesh {
+            edges: vec![-1.0, -0.5, 0.1, 0.2, 0.7, 1.5],
+        };
+        let inf = Influence::new(&mesh, 3.0);
+        let v = [0.3, -1.2, 2.0, 0.7, -0.4];
+        let mut out = [0.0; 5];
+        inf.sign_apply(&v, &mut out);
+        let w = mesh.widths();
+        for i in 0..5 {
+            let direct: f64 = (0..5).map(|j| sign_pair(i, j, w[i], w[j]) * v[j]).sum();
+            assert!(
+                (out[i] - direct).abs() < 1e-14,
+                "{i}: {} vs {direct}",
+                out[i]
+            );
+        }
+    }
 
     /// The closed form against a fine midpoint rule in both variables (well separated and
     /// adjacent elements) and the self term `h²(ln(h/d) − 3/2)`.

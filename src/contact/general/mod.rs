@@ -11,6 +11,8 @@ mod dense;
 mod normal;
 mod tangential;
 
+#[cfg(test)]
+mod tests;
 
 use std::f64::consts::PI;
 
@@ -19,6 +21,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{ContactModel, Coupling, Electrode};
 use crate::error::SolveFailure;
+use dense::Workspace;
 use influence::Influence;
 pub use mesh::{Focus, Mesh};
 use normal::{NormalInput, NormalSolution};
@@ -95,7 +98,7 @@ impl Default for Options {
         Self {
             freeze_after: 4,
             max_outer: 60,
-            tolerance: 1e-10,
+            tolerance: 1e-8,
         }
     }
 }
@@ -311,6 +314,7 @@ impl Solver {
             residual: 0.0,
             normal_cycled: false,
         };
+        let mut work = Workspace::default();
         for outer in 0..self.options.max_outer {
             let input = NormalInput {
                 mesh: &self.mesh,
@@ -321,11 +325,16 @@ impl Solver {
                 electric: control,
                 grow: outer < self.options.freeze_after,
             };
-            let normal = normal::solve(&input, contact)?;
+            let normal = normal::solve(&input, contact, &mut work)?;
             let p_start = p_old.clone();
             contact = normal.contact.clone();
-            let (q_new, tangential) =
-                self.tangential(previous, &normal, loads.tangential, (&q, &p_start))?;
+            let (q_new, tangential) = self.tangential(
+                previous,
+                &normal,
+                loads.tangential,
+                (&q, &p_start),
+                &mut work,
+            )?;
             let pmax = normal.pressure.iter().cloned().fold(0.0, f64::max);
             let dq = q_new
                 .iter()
@@ -377,11 +386,11 @@ impl Solver {
         let n = self.mesh.len();
         let c = &self.coefficients;
         let mut sp = vec![0.0; n];
-        Influence::apply(&self.influence.sign, pressure, &mut sp);
+        self.influence.sign_apply(pressure, &mut sp);
         let mut out: Vec<f64> = sp.iter().map(|v| -0.5 * c.w12 * v).collect();
         if let Some((_, _, w13)) = c.electric {
             let mut sg = vec![0.0; n];
-            Influence::apply(&self.influence.sign, charge, &mut sg);
+            self.influence.sign_apply(charge, &mut sg);
             for (o, v) in out.iter_mut().zip(&sg) {
                 *o -= 0.5 * w13 * v;
             }
@@ -397,6 +406,7 @@ impl Solver {
         normal: &NormalSolution,
         total: f64,
         (start, start_pressure): (&[f64], &[f64]),
+        work: &mut Workspace,
     ) -> Result<(Vec<f64>, Tangential), SolveFailure> {
         let n = self.mesh.len();
         let c = &self.coefficients;
@@ -455,8 +465,9 @@ impl Solver {
             w: &w,
             bound: &bound,
             total,
+            elements: &act,
         };
-        let m = tangential::minimise(&programme, &begin, &begin_status)?;
+        let m = tangential::minimise(&programme, &begin, &begin_status, work)?;
         for (r, &i) in act.iter().enumerate() {
             q[i] = m.q[r];
             out.slip[i] = m.slip[r];
@@ -481,7 +492,7 @@ impl Solver {
         let c = &self.coefficients;
         let mut ux = self.fixed_displacement(&normal.pressure, &normal.charge);
         let mut lq = vec![0.0; n];
-        Influence::apply(&self.influence.log, &shear, &mut lq);
+        self.influence.log_apply(&shear, &mut lq);
         for (i, u) in ux.iter_mut().enumerate() {
             *u = (*u - (c.y11 / PI) * lq[i]) / self.mesh.width(i);
         }

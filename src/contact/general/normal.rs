@@ -6,6 +6,7 @@ use std::f64::consts::PI;
 
 use faer::Mat;
 
+use super::dense::{Factored, Workspace};
 use super::influence::{Influence, profile_integral};
 use super::mesh::Mesh;
 use super::{Coefficients, ElectricControl};
@@ -45,6 +46,7 @@ pub(super) struct NormalSolution {
 pub(super) fn solve(
     input: &NormalInput,
     mut contact: Vec<bool>,
+    work: &mut Workspace,
 ) -> Result<NormalSolution, SolveFailure> {
     let n = input.mesh.len();
     let mut seen: HashSet<Vec<bool>> = HashSet::new();
@@ -55,7 +57,7 @@ pub(super) fn solve(
                 reason: "the normal subproblem lost every contact element".into(),
             });
         }
-        let mut sol = solve_on(input, &contact)?;
+        let mut sol = solve_on(input, &contact, work)?;
         sol.iterations = iteration;
         let negative: Vec<usize> = (0..n)
             .filter(|&i| contact[i] && sol.pressure[i] < 0.0)
@@ -105,14 +107,14 @@ fn gaps(input: &NormalInput, sol: &NormalSolution) -> Vec<f64> {
     let c = input.coefficients;
     let n = input.mesh.len();
     let mut lp = vec![0.0; n];
-    Influence::apply(&input.influence.log, &sol.pressure, &mut lp);
+    input.influence.log_apply(&sol.pressure, &mut lp);
     let mut lg = vec![0.0; n];
     if c.electric.is_some() {
-        Influence::apply(&input.influence.log, &sol.charge, &mut lg);
+        input.influence.log_apply(&sol.charge, &mut lg);
     }
     let mut sq = vec![0.0; n];
     if c.coupled {
-        Influence::apply(&input.influence.sign, input.shear, &mut sq);
+        input.influence.sign_apply(input.shear, &mut sq);
     }
     let (y23, _, _) = c.electric.unwrap_or((0.0, 0.0, 0.0));
     (0..n)
@@ -126,7 +128,11 @@ fn gaps(input: &NormalInput, sol: &NormalSolution) -> Vec<f64> {
 }
 
 /// The linear contact equations on a fixed set (module docs, "normal subproblem").
-fn solve_on(input: &NormalInput, contact: &[bool]) -> Result<NormalSolution, SolveFailure> {
+fn solve_on(
+    input: &NormalInput,
+    contact: &[bool],
+    work: &mut Workspace,
+) -> Result<NormalSolution, SolveFailure> {
     let c = input.coefficients;
     let mesh = input.mesh;
     let n = mesh.len();
@@ -143,13 +149,14 @@ fn solve_on(input: &NormalInput, contact: &[bool]) -> Result<NormalSolution, Sol
     let mut b = vec![0.0; size];
     let mut sq = vec![0.0; n];
     if c.coupled {
-        Influence::apply(&input.influence.sign, input.shear, &mut sq);
+        input.influence.sign_apply(input.shear, &mut sq);
     }
     let col_dz = if has_g { 2 * m } else { m };
+    let cached = matches!(&work.normal, Some((set, _)) if set.as_slice() == contact);
     for (r, &i) in act.iter().enumerate() {
         let (x1, x2) = (mesh.edges[i], mesh.edges[i + 1]);
         let w = x2 - x1;
-        for (k, &j) in act.iter().enumerate() {
+        for (k, &j) in act.iter().enumerate().filter(|_| !cached) {
             let l = input.influence.log[(i, j)];
             a[(r, k)] = -(c.y22 / PI) * l;
             if has_g {
@@ -181,7 +188,14 @@ fn solve_on(input: &NormalInput, contact: &[bool]) -> Result<NormalSolution, Sol
     {
         b[row_p + 1] = gamma;
     }
-    let x = super::dense::solve(a, b).ok_or(SolveFailure::NonFinite {
+    if !cached {
+        let f = Factored::new(a).ok_or(SolveFailure::NonFinite {
+            field: "normal subproblem matrix",
+        })?;
+        work.normal = Some((contact.to_vec(), f));
+    }
+    let factored = &work.normal.as_ref().expect("factored above").1;
+    let x = factored.solve(&b).ok_or(SolveFailure::NonFinite {
         field: "normal subproblem solution",
     })?;
     let mut pressure = vec![0.0; n];

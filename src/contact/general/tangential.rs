@@ -4,6 +4,9 @@
 
 use faer::Mat;
 
+use super::dense::{Factored, Workspace};
+use super::influence::dot;
+
 use crate::error::SolveFailure;
 
 /// The programme `min ½ qᵀK q + cᵀq` subject to `−u ≤ q ≤ u` and `wᵀq = Q`, on the contact
@@ -19,6 +22,8 @@ pub(super) struct Programme<'a> {
     pub bound: &'a [f64],
     /// Q (N/m).
     pub total: f64,
+    /// The mesh indices of the contact elements (the key of the cached factorizations).
+    pub elements: &'a [usize],
 }
 
 /// Status of one element in the working set.
@@ -92,19 +97,34 @@ fn status_of(q: &[f64], bound: &[f64]) -> Vec<Bound> {
 }
 
 /// The equality-constrained step on the free set: `[K_FF −w_F; w_Fᵀ 0](d; λ) = (−∇_F; 0)`.
-fn free_step(p: &Programme, free: &[usize], grad: &[f64]) -> Result<(Vec<f64>, f64), SolveFailure> {
+fn free_step(
+    p: &Programme,
+    free: &[usize],
+    grad: &[f64],
+    work: &mut Workspace,
+) -> Result<(Vec<f64>, f64), SolveFailure> {
     let m = free.len();
-    let mut a = Mat::<f64>::zeros(m + 1, m + 1);
+    let cached = matches!(&work.tangential, Some((e, f, _)) if e.as_slice() == p.elements && f.as_slice() == free);
+    if !cached {
+        let mut a = Mat::<f64>::zeros(m + 1, m + 1);
+        for (r, &i) in free.iter().enumerate() {
+            for (s, &j) in free.iter().enumerate() {
+                a[(r, s)] = p.k[(i, j)];
+            }
+            a[(r, m)] = -p.w[i];
+            a[(m, r)] = p.w[i];
+        }
+        let f = Factored::new(a).ok_or(SolveFailure::NonFinite {
+            field: "tangential step matrix",
+        })?;
+        work.tangential = Some((p.elements.to_vec(), free.to_vec(), f));
+    }
     let mut b = vec![0.0; m + 1];
     for (r, &i) in free.iter().enumerate() {
-        for (s, &j) in free.iter().enumerate() {
-            a[(r, s)] = p.k[(i, j)];
-        }
-        a[(r, m)] = -p.w[i];
-        a[(m, r)] = p.w[i];
         b[r] = -grad[i];
     }
-    let x = super::dense::solve(a, b).ok_or(SolveFailure::NonFinite {
+    let factored = &work.tangential.as_ref().expect("factored above").2;
+    let x = factored.solve(&b).ok_or(SolveFailure::NonFinite {
         field: "tangential step",
     })?;
     Ok((x[..m].to_vec(), x[m]))
@@ -118,17 +138,25 @@ pub(super) fn minimise(
     p: &Programme,
     start: &[f64],
     start_status: &[Bound],
+    work: &mut Workspace,
 ) -> Result<Minimiser, SolveFailure> {
     let n = p.c.len();
     // Slip scale: the largest mean displacement an admissible traction produces.
     let scale = (0..n)
-        .map(|i| (0..n).map(|j| p.k[(i, j)].abs() * p.bound[j]).sum::<f64>() / p.w[i])
+        .map(|i| {
+            let col = p.k.col_as_slice(i);
+            col.iter()
+                .zip(p.bound)
+                .map(|(k, u)| k.abs() * u)
+                .sum::<f64>()
+                / p.w[i]
+        })
         .fold(0.0, f64::max);
     let tol = 1e-10 * scale;
-    if let Some(m) = primal_dual(p, start_status, tol)? {
+    if let Some(m) = primal_dual(p, start_status, tol, work)? {
         return Ok(m);
     }
-    primal(p, start, tol)
+    primal(p, start, tol, work)
 }
 
 /// Primal–dual active set (Hintermüller, Ito & Kunisch 2003): fix the bound elements at their
@@ -139,6 +167,7 @@ fn primal_dual(
     p: &Programme,
     start: &[Bound],
     tol: f64,
+    work: &mut Workspace,
 ) -> Result<Option<Minimiser>, SolveFailure> {
     let n = p.c.len();
     let mut status = start.to_vec();
@@ -157,7 +186,7 @@ fn primal_dual(
         // Make the equality hold through the free elements: Q − (bound part) on them.
         let bound_part: f64 = q.iter().zip(p.w).map(|(q, w)| q * w).sum();
         let mut grad: Vec<f64> = (0..n)
-            .map(|i| (0..n).map(|j| p.k[(i, j)] * q[j]).sum::<f64>() + p.c[i])
+            .map(|i| dot(p.k.col_as_slice(i), &q) + p.c[i])
             .collect();
         let wf: f64 = free.iter().map(|&i| p.w[i] * p.w[i]).sum();
         // A particular free traction meeting the equality, then the free step from it.
@@ -166,16 +195,12 @@ fn primal_dual(
             q[i] = t * p.w[i];
         }
         for &i in &free {
-            for (j, g) in grad.iter_mut().enumerate() {
-                *g += p.k[(j, i)] * t * p.w[i];
-            }
+            axpy(&mut grad, t * p.w[i], p.k.col_as_slice(i));
         }
-        let (d, shift) = free_step(p, &free, &grad)?;
+        let (d, shift) = free_step(p, &free, &grad, work)?;
         for (k, &i) in free.iter().enumerate() {
             q[i] += d[k];
-            for (j, g) in grad.iter_mut().enumerate() {
-                *g += p.k[(j, i)] * d[k];
-            }
+            axpy(&mut grad, d[k], p.k.col_as_slice(i));
         }
         let slip: Vec<f64> = (0..n)
             .map(|i| match status[i] {
@@ -214,20 +239,25 @@ fn primal_dual(
 /// set) or, at that minimiser, releases the bound element whose slip most contradicts its
 /// friction. The objective decreases strictly on every step that moves, so the method
 /// terminates (barring degeneracy, guarded by an iteration limit).
-fn primal(p: &Programme, start: &[f64], tol: f64) -> Result<Minimiser, SolveFailure> {
+fn primal(
+    p: &Programme,
+    start: &[f64],
+    tol: f64,
+    work: &mut Workspace,
+) -> Result<Minimiser, SolveFailure> {
     let n = p.c.len();
     let mut q = feasible_start(p, start)?;
     let mut status = status_of(&q, p.bound);
     let limit = 20 * n + 20;
     for iteration in 1..=limit {
         let mut grad: Vec<f64> = (0..n)
-            .map(|i| (0..n).map(|j| p.k[(i, j)] * q[j]).sum::<f64>() + p.c[i])
+            .map(|i| dot(p.k.col_as_slice(i), &q) + p.c[i])
             .collect();
         let free: Vec<usize> = (0..n).filter(|&i| status[i] == Bound::Free).collect();
         let shift = if free.is_empty() {
             shift_without_free(p, &grad, &status)
         } else {
-            let (d, shift) = free_step(p, &free, &grad)?;
+            let (d, shift) = free_step(p, &free, &grad, work)?;
             let mut alpha = 1.0;
             let mut blocking = None;
             for (k, &i) in free.iter().enumerate() {
@@ -245,9 +275,7 @@ fn primal(p: &Programme, start: &[f64], tol: f64) -> Result<Minimiser, SolveFail
             }
             for (k, &i) in free.iter().enumerate() {
                 q[i] += alpha * d[k];
-                for (j, g) in grad.iter_mut().enumerate() {
-                    *g += alpha * p.k[(j, i)] * d[k];
-                }
+                axpy(&mut grad, alpha * d[k], p.k.col_as_slice(i));
             }
             if let Some((i, up)) = blocking {
                 q[i] = if up { p.bound[i] } else { -p.bound[i] };
@@ -310,5 +338,12 @@ fn shift_without_free(p: &Programme, grad: &[f64], status: &[Bound]) -> f64 {
         (true, false) => lo,
         (false, true) => hi,
         (false, false) => 0.0,
+    }
+}
+
+/// `y += a x`.
+fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    for (y, x) in y.iter_mut().zip(x) {
+        *y += a * x;
     }
 }
