@@ -268,3 +268,83 @@ fn spence_stick_ratio_goodman_and_full_coupling() {
         }
     }
 }
+
+/// PZT-4 under a conducting punch (Γ = 6e−7 C/m, R = 60 mm, P = 2000 N/m): frictionless, the
+/// half-width of Zhou & Lee's closed form and ∫g = Γ; with η = 0.3 and P, Γ rising together,
+/// the stick zone and half-width of the spectral solver (b/a = 0.953628, a = 4.183652e−5 m).
+#[test]
+fn pzt4_conducting_punch_zhou_lee_and_baseline_stick_zone() {
+    use crate::analytical::ZhouLee;
+    use crate::material::PZT4;
+    let (p, gamma, radius) = (2000.0, 6e-7, 0.06);
+    let model = |friction| {
+        ContactModel::new(
+            Material::Piezoelectric(PZT4),
+            radius,
+            friction,
+            Electrode::ConductingCharge { charge: gamma },
+        )
+    };
+    let c = model(0.0).compliance;
+    let exact = ZhouLee::new(
+        p,
+        radius,
+        c.pressure_compliance(),
+        c.charge_per_force(),
+        gamma,
+    );
+    let a = exact.hertz.half_width;
+    let at = |f: f64| Loads {
+        normal: p * f,
+        tangential: 0.0,
+        electric: gamma * f,
+    };
+    for end in [4e-3, 2e-3, 1e-3] {
+        let solver = Solver::new(&model(0.0), graded(a, end, 10.0 * end), Options::default());
+        let (s, _) = solver
+            .step(&GeneralState::unloaded(solver.mesh().clone()), at(1.0))
+            .unwrap();
+        let (lo, hi) = s.contact_extent().unwrap();
+        let (force, _, charge) = s.resultants();
+        // Measured |Δa|/a = 0.15 of the end element at each mesh, as for Hertz.
+        assert!((hi - a).abs() <= width_at(&s.mesh, a) && (lo + a).abs() <= width_at(&s.mesh, -a));
+        assert!((force - p).abs() < 1e-10 * p && (charge - gamma).abs() < 1e-10 * gamma);
+    }
+    let spectral = solve_normal(
+        &model(0.3),
+        &Discretisation::new(64),
+        p,
+        NormalOptions::default(),
+    )
+    .unwrap();
+    let b_ref = spectral.stick_half_width / spectral.state.half_width;
+    assert!(
+        (b_ref - 0.953628).abs() < 1e-6
+            && (spectral.state.half_width / 4.183652e-5 - 1.0).abs() < 1e-6
+    );
+    let solver = Solver::new(&model(0.3), graded(a, 5e-4, 1e-2), Options::default());
+    let mut s = GeneralState::unloaded(solver.mesh().clone());
+    let steps = (10f64.ln() / 1.02f64.ln()).ceil() as i32;
+    for k in 0..=steps {
+        let f = (0.1 * 1.02f64.powi(k)).min(1.0);
+        s = solver.step(&s, at(f * f)).unwrap().0;
+    }
+    let (lo, hi) = s.contact_extent().unwrap();
+    let b = s.length_of(ElementState::Stick) / (hi - lo);
+    let half = 0.5 * (hi - lo);
+    eprintln!(
+        "PZT-4 ({} el.): b/a = {b:.5} (spectral {b_ref:.6}), a = {half:.6e} m (spectral {:.6e})",
+        s.mesh.len(),
+        spectral.state.half_width
+    );
+    // Measured b/a = 0.95464 (Δ = 1.0e−3, element width at b 4.2e−3 a) and
+    // a = 4.182990e−5 m (Δa/a = −1.6e−4, end element 5e−4 a).
+    let kinds: Vec<ElementState> = s.zones().iter().map(|z| z.0).collect();
+    use ElementState::*;
+    assert_eq!(
+        kinds,
+        [Exterior, SlipPositive, Stick, SlipNegative, Exterior]
+    );
+    assert!((b - b_ref).abs() <= width_at(&s.mesh, b_ref * half) / half);
+    assert!((half - spectral.state.half_width).abs() <= width_at(&s.mesh, half));
+}
