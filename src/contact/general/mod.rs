@@ -1,8 +1,96 @@
-//! A general element solver for the line contact (Kalker's method, as in E.A.H. Vollebregt's
-//! CONTACT): every element of a band covering the contact is out of contact, stuck, or
-//! slipping either way, decided by the solution and not assumed in advance.
+//! A general element solver for the line contact after Kalker's method (J.J. Kalker,
+//! *Three-dimensional elastic bodies in rolling contact*, 1990; E.A.H. Vollebregt's CONTACT):
+//! every element of a band covering the contact is out of contact, stuck, or slipping either
+//! way, as the solution decides. No zone structure is assumed, so extra stick and slip zones at
+//! the contact ends (coupled contacts, varying loads) are represented.
 //!
-//! DOCS-PLACEHOLDER
+//! # Conventions
+//! Those of [`crate::contact`]: x along the surface with the punch axis at x = 0, `p`
+//! compressive positive, `q` the shear traction the punch exerts *on the half-plane* (so
+//! `∫q = Q` is the tangential force on the punch), `g = −Dz(x, 0⁺)`, `uz` positive into the
+//! solid. The punch has a rigid approach δz and a rigid tangential displacement δx, both
+//! measured with the datum d of the logarithmic kernel (`model.reference_distance`).
+//! The **slip** of a step is the displacement of the half-plane's surface relative to the
+//! punch, `s = (ux − ux_prev) − (δx − δx_prev)`; Coulomb friction opposes it,
+//! `q = −ηp sign(s)` where `s ≠ 0`. An element is [`ElementState::Stick`] when its slip in the
+//! step is zero (to a relative 1e−10), also if `|q| = ηp` there.
+//!
+//! # Surface displacements (seed eqs. 11–13 integrated once)
+//! With `(1/π)⨍ f(s)/(s − x) ds = (d/dx)[−(1/π)∫ f(s) ln(|x − s|/d) ds]` and
+//! `f(x) = (d/dx)[½∫ f(s) sign(x − s) ds]`, eqs. (11)–(13) ([`crate::halfplane`]) integrate to
+//!
+//! ```text
+//! ux(x) = −(w12/2) ∫p sign(x − s) ds − (w13/2) ∫g sign(x − s) ds − (y11/π) ∫q ln(|x − s|/d) ds
+//! uz(x) =  (w12/2) ∫q sign(x − s) ds − (y22/π) ∫p ln(|x − s|/d) ds − (y23/π) ∫g ln(|x − s|/d) ds
+//! φ(x)  =  (w13/2) ∫q sign(x − s) ds − (y23/π) ∫p ln(|x − s|/d) ds − (y33/π) ∫g ln(|x − s|/d) ds
+//! ```
+//!
+//! up to constants, which the rigid-body unknowns δz, δx and φ0 absorb.
+//!
+//! # Elements
+//! p, q and g are constant on each element of a [`Mesh`]; the contact conditions hold for the
+//! element means (Galerkin). With element `i` = `[x1, x2]` and `j` = `[s1, s2]`,
+//!
+//! ```text
+//! L_ij = ∫∫ ln(|x − s|/d) ds dx = G(x2 − s1) − G(x1 − s1) − G(x2 − s2) + G(x1 − s2),
+//!        G(t) = t²/2 · ln(|t|/d) − 3t²/4      (G'' = ln(|t|/d), self term h²(ln(h/d) − 3/2))
+//! S_ij = ∫∫ sign(x − s) ds dx = w_i w_j sign(i − j)           (w the element widths)
+//! Z_i  = ∫ x²/(2R) dx = (x2³ − x1³)/(6R)
+//! ```
+//!
+//! so that the element integrals of the displacements are `Ux = −(w12/2)S p − (w13/2)S g −
+//! (y11/π)L q`, `Uz = (w12/2)S q − (y22/π)L p − (y23/π)L g`, `Φ = (w13/2)S q − (y23/π)L p −
+//! (y33/π)L g`. Piecewise-constant elements make `p ≥ 0` and `|q| ≤ ηp` exact element by
+//! element, and the Galerkin form makes `L` symmetric: `K = −(y11/π)L` is positive definite
+//! when d exceeds the logarithmic capacity of the band (a quarter of its length), so the
+//! tangential subproblem below is a strictly convex programme with an exact energy. The price
+//! is first-order resolution of the contact and stick ends (each lies within an element);
+//! graded meshes ([`Mesh::graded`], [`Mesh::symmetric`]) put small elements there.
+//!
+//! # Normal and electric subproblem (q fixed)
+//! On the set C of contact elements, with unknowns `p_C`, `g_C`, δz and φ0:
+//!
+//! ```text
+//! Uz_i − w_i δz + Z_i = 0          (zero gap, i ∈ C)
+//! Φ_i − w_i φ0 = 0                 (conducting punch: constant potential, i ∈ C)
+//! Σ w_j p_j = P,   Σ w_j g_j = Γ   (charge control; potential control fixes φ0 instead)
+//! ```
+//!
+//! The insulating punch and the elastic half-plane have `g = 0` and no potential rows. Under
+//! Goodman's approximation ([`Coupling::Goodman`]) the q terms are dropped from `Uz` and `Φ`.
+//! C is found by Kalker's active set (NORM): solve on C; drop every element with `p < 0`; else
+//! add every element outside C whose mean gap `(Uz_i − w_i δz + Z_i)/w_i` is negative (below
+//! −1e−9 of the profile height at the contact end); stop when neither happens. A set met
+//! before ends the search with the last set that had `p ≥ 0`.
+//!
+//! # Tangential subproblem (p and g fixed)
+//! With `U⁰` the element integrals of the previous step's `ux` (the slip reference) and
+//! `c = Ux(p, g) − U⁰`, the tractions minimise the incremental complementary energy
+//!
+//! ```text
+//! J(q) = ½ qᵀK q + cᵀq   subject to   −ηp_i ≤ q_i ≤ ηp_i,   Σ w_i q_i = Q,
+//! ```
+//!
+//! over the contact elements. Its KKT conditions are Coulomb's law: the multiplier of the
+//! equality is the increment of δx, and `(∂J/∂q_i)/w_i − Δδx` is the element's mean slip,
+//! zero where `|q_i| < ηp_i`, `≤ 0` where `q_i = ηp_i` and `≥ 0` where `q_i = −ηp_i`. It is
+//! solved by the primal–dual active-set method (semismooth Newton on the complementarity
+//! conditions), warm-started from the previous working set; if that does not settle in 30
+//! iterations, by the primal active-set method, which decreases J monotonically and
+//! terminates.
+//!
+//! # Alternation
+//! When q changes p or g (`w12 ≠ 0`, or `w13 ≠ 0` under a conducting punch, and full
+//! coupling), the two subproblems alternate until p and q change by less than
+//! [`Options::tolerance`] (relative to max p and η max p). After [`Options::freeze_after`]
+//! outer iterations elements may leave the contact but not enter it, so that an element at a
+//! contact end cannot cycle between states. Matrix factorizations are reused while the element
+//! sets that define them are unchanged.
+//!
+//! # State
+//! [`GeneralState`] is plain data: the mesh, p, q, g, ux and the slip per element, the element
+//! states, δz, δx, φ0 and the loads. It is the slip reference of the next step; the influence
+//! matrices are rebuilt from the mesh by [`Solver::new`].
 
 pub mod influence;
 pub mod mesh;
@@ -220,7 +308,8 @@ impl GeneralState {
 }
 
 impl Solver {
-    /// A solver for a model on a mesh.
+    /// A solver for a model on a mesh. The datum d should exceed a quarter of the mesh's
+    /// length, so that the tangential programme is strictly convex (module docs).
     pub fn new(model: &ContactModel, mesh: Mesh, options: Options) -> Self {
         let c = &model.compliance;
         let electric = match model.electrode {
