@@ -475,3 +475,63 @@ fn coupled_reversal_forms_old_direction_layers_at_the_ends() {
     eprintln!("old-direction slip lengths / a: {old:?}");
     assert!(old[4] < 0.1 * old[0], "{old:?}");
 }
+
+/// The other electrodes: potential control at the φ0 of a charge-controlled solve returns its
+/// Γ; an insulating punch carries no charge and gives Hertz's width with the compliance y22.
+#[test]
+fn potential_control_and_insulating_punch() {
+    use crate::material::PZT4;
+    let (p, gamma, radius) = (2000.0, 6e-7, 0.06);
+    let model =
+        |electrode| ContactModel::new(Material::Piezoelectric(PZT4), radius, 0.3, electrode);
+    let charged = model(Electrode::ConductingCharge { charge: gamma });
+    let c = charged.compliance;
+    let a = Hertz::new(p, radius, c.pressure_compliance()).half_width;
+    let mesh = graded(a, 1e-3, 1e-2);
+    let unloaded = GeneralState::unloaded(mesh.clone());
+    let at = |electric| Loads {
+        normal: p,
+        tangential: 0.1 * 0.3 * p,
+        electric,
+    };
+    let solver = Solver::new(&charged, mesh.clone(), Options::default());
+    let (s, _) = solver.step(&unloaded, at(gamma)).unwrap();
+    let potential = model(Electrode::ConductingPotential {
+        potential: s.potential,
+    });
+    let solver = Solver::new(&potential, mesh.clone(), Options::default());
+    let (t, _) = solver.step(&unloaded, at(s.potential)).unwrap();
+    let (_, _, charge) = t.resultants();
+    assert!((charge - gamma).abs() < 1e-9 * gamma, "{charge} vs {gamma}");
+    assert!(relative_difference(&t.pressure, &s.pressure) < 1e-9);
+    assert!(relative_difference(&t.shear, &s.shear) < 1e-9);
+    let insulating = model(Electrode::Insulating);
+    let a = Hertz::new(p, radius, c.y22).half_width;
+    let mesh = graded(a, 1e-3, 1e-2);
+    let solver = Solver::new(
+        &insulating.clone().with_coupling(Coupling::Full),
+        mesh.clone(),
+        Options::default(),
+    );
+    let frictionless = ContactModel {
+        friction: 0.0,
+        ..insulating
+    };
+    let solver_0 = Solver::new(&frictionless, mesh.clone(), Options::default());
+    let (u, _) = solver_0
+        .step(
+            &GeneralState::unloaded(mesh.clone()),
+            Loads {
+                tangential: 0.0,
+                ..at(0.0)
+            },
+        )
+        .unwrap();
+    let (lo, hi) = u.contact_extent().unwrap();
+    assert!(u.charge.iter().all(|&g| g == 0.0));
+    assert!((hi - a).abs() <= width_at(&mesh, a) && (lo + a).abs() <= width_at(&mesh, -a));
+    let (v, _) = solver
+        .step(&GeneralState::unloaded(mesh.clone()), at(0.0))
+        .unwrap();
+    assert!(v.charge.iter().all(|&g| g == 0.0));
+}
