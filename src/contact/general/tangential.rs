@@ -347,3 +347,60 @@ fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
         *y += a * x;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::general::influence::Influence;
+    use crate::contact::general::mesh::Mesh;
+
+    /// Both methods reach the same minimiser of a programme with slip zones of both signs, and
+    /// it satisfies the KKT conditions (Coulomb's law) to the slip tolerance.
+    #[test]
+    fn primal_and_primal_dual_agree_and_satisfy_coulomb() {
+        let mesh = Mesh::uniform(-1.0, 1.0, 40);
+        let inf = Influence::new(&mesh, 10.0);
+        let n = mesh.len();
+        let k = Mat::<f64>::from_fn(n, n, |i, j| -inf.log[(i, j)] / std::f64::consts::PI);
+        let x = mesh.centres();
+        let w = mesh.widths();
+        // A linear term that drives opposite slips at the two ends, and Hertzian bounds.
+        let c: Vec<f64> = x.iter().zip(&w).map(|(x, w)| w * 0.3 * x * x * x).collect();
+        let bound: Vec<f64> = x.iter().map(|x| 0.3 * (1.0 - x * x).sqrt()).collect();
+        let elements: Vec<usize> = (0..n).collect();
+        let p = Programme {
+            k: &k,
+            c: &c,
+            w: &w,
+            bound: &bound,
+            total: 0.1,
+            elements: &elements,
+        };
+        let tol = 1e-12;
+        let a = primal(&p, &vec![0.0; n], tol, &mut Workspace::default()).unwrap();
+        let b = primal_dual(&p, &vec![Bound::Free; n], tol, &mut Workspace::default())
+            .unwrap()
+            .expect("settles");
+        let diff =
+            a.q.iter()
+                .zip(&b.q)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max);
+        assert!(diff < 1e-10, "{diff}");
+        assert!((a.shift - b.shift).abs() < 1e-10);
+        for m in [&a, &b] {
+            let total: f64 = m.q.iter().zip(&w).map(|(q, w)| q * w).sum();
+            assert!((total - 0.1).abs() < 1e-12);
+            for (i, u) in bound.iter().enumerate() {
+                assert!(m.q[i].abs() <= u * (1.0 + 1e-12));
+                match m.status[i] {
+                    Bound::Upper => assert!(m.slip[i] <= tol),
+                    Bound::Lower => assert!(m.slip[i] >= -tol),
+                    Bound::Free => assert!(m.q[i].abs() < *u),
+                }
+            }
+            assert!(m.status.contains(&Bound::Upper) && m.status.contains(&Bound::Lower));
+            assert!(m.status.contains(&Bound::Free));
+        }
+    }
+}
