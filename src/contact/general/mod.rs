@@ -87,6 +87,13 @@
 //! contact end cannot cycle between states. Matrix factorizations are reused while the element
 //! sets that define them are unchanged.
 //!
+//! # Resolution
+//! Contact and stick-zone ends lie within one element (a stick run ends at an element edge;
+//! an element that a stick end crosses slips). The pressure converges at second order in the
+//! element size away from the contact ends and at order ½ in the end element, where
+//! `p ~ √(a − x)`. Path-dependent results (the stick zone of incremental normal loading)
+//! converge at first order in the load step.
+//!
 //! # State
 //! [`GeneralState`] is plain data: the mesh, p, q, g, ux and the slip per element, the element
 //! states, δz, δx, φ0 and the loads. It is the slip reference of the next step; the influence
