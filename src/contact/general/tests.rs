@@ -262,10 +262,11 @@ fn spence_stick_ratio_goodman_and_full_coupling() {
                 assert!((extrapolated - reference).abs() <= resolution);
             }
             // Measured 0.68741 with both steps (the stick run ends at the same element edge),
-            // against the seed paper's 0.689 ± 0.003 and the spectral solver's 0.68949. With
-            // elements of 5e−4 a at b and 1 % steps the result is 0.68827, 1.2e−3 from the
-            // spectral value: within the resolution of a, whose end element is 1.5e−3 a here
-            // (the coupled contact ends at 0.977 of Hertz's a, off the mesh's focus).
+            // against the seed paper's 0.689 ± 0.003. With elements of 2.5e−4 a at the contact
+            // end and 5e−4 a at b, and 1 % or 0.5 % steps: 0.68805, with a within 1e−4 of the
+            // spectral solver's. The spectral solver gives 0.68949 (M = 64) and 0.68921
+            // (M = 128); the remaining 1.2e−3 is larger than the element resolution at b and
+            // is not explained here.
             Coupling::Full => assert!((extrapolated - 0.689).abs() <= 0.003),
         }
     }
