@@ -55,6 +55,7 @@
 //! valid on and off the contact (off it p = q = g = 0 and only the Cauchy terms remain).
 
 pub mod frictionless;
+pub mod general;
 pub mod memory;
 pub mod normal;
 pub mod pressure;

@@ -1,0 +1,621 @@
+//! A general element solver for the line contact after Kalker's method (J.J. Kalker,
+//! *Three-dimensional elastic bodies in rolling contact*, 1990; E.A.H. Vollebregt's CONTACT):
+//! every element of a band covering the contact is out of contact, stuck, or slipping either
+//! way, as the solution decides. No zone structure is assumed, so extra stick and slip zones at
+//! the contact ends (coupled contacts, varying loads) are represented.
+//!
+//! # Conventions
+//! Those of [`crate::contact`]: x along the surface with the punch axis at x = 0, `p`
+//! compressive positive, `q` the shear traction the punch exerts *on the half-plane* (so
+//! `∫q = Q` is the tangential force on the punch), `g = −Dz(x, 0⁺)`, `uz` positive into the
+//! solid. The punch has a rigid approach δz and a rigid tangential displacement δx, both
+//! measured with the datum d of the logarithmic kernel (`model.reference_distance`).
+//! The **slip** of a step is the displacement of the half-plane's surface relative to the
+//! punch, `s = (ux − ux_prev) − (δx − δx_prev)`; Coulomb friction opposes it,
+//! `q = −ηp sign(s)` where `s ≠ 0`. An element is [`ElementState::Stick`] when its slip in the
+//! step is zero (to a relative 1e−10), also if `|q| = ηp` there.
+//!
+//! # Surface displacements (seed eqs. 11–13 integrated once)
+//! With `(1/π)⨍ f(s)/(s − x) ds = (d/dx)[−(1/π)∫ f(s) ln(|x − s|/d) ds]` and
+//! `f(x) = (d/dx)[½∫ f(s) sign(x − s) ds]`, eqs. (11)–(13) ([`crate::halfplane`]) integrate to
+//!
+//! ```text
+//! ux(x) = −(w12/2) ∫p sign(x − s) ds − (w13/2) ∫g sign(x − s) ds − (y11/π) ∫q ln(|x − s|/d) ds
+//! uz(x) =  (w12/2) ∫q sign(x − s) ds − (y22/π) ∫p ln(|x − s|/d) ds − (y23/π) ∫g ln(|x − s|/d) ds
+//! φ(x)  =  (w13/2) ∫q sign(x − s) ds − (y23/π) ∫p ln(|x − s|/d) ds − (y33/π) ∫g ln(|x − s|/d) ds
+//! ```
+//!
+//! up to constants, which the rigid-body unknowns δz, δx and φ0 absorb.
+//!
+//! # Elements
+//! p, q and g are constant on each element of a [`Mesh`]; the contact conditions hold for the
+//! element means (Galerkin). With element `i` = `[x1, x2]` and `j` = `[s1, s2]`,
+//!
+//! ```text
+//! L_ij = ∫∫ ln(|x − s|/d) ds dx = G(x2 − s1) − G(x1 − s1) − G(x2 − s2) + G(x1 − s2),
+//!        G(t) = t²/2 · ln(|t|/d) − 3t²/4      (G'' = ln(|t|/d), self term h²(ln(h/d) − 3/2))
+//! S_ij = ∫∫ sign(x − s) ds dx = w_i w_j sign(i − j)           (w the element widths)
+//! Z_i  = ∫ x²/(2R) dx = (x2³ − x1³)/(6R)
+//! ```
+//!
+//! so that the element integrals of the displacements are `Ux = −(w12/2)S p − (w13/2)S g −
+//! (y11/π)L q`, `Uz = (w12/2)S q − (y22/π)L p − (y23/π)L g`, `Φ = (w13/2)S q − (y23/π)L p −
+//! (y33/π)L g`. Piecewise-constant elements make `p ≥ 0` and `|q| ≤ ηp` exact element by
+//! element, and the Galerkin form makes `L` symmetric: `K = −(y11/π)L` is positive definite
+//! when d exceeds the logarithmic capacity of the band (a quarter of its length), so the
+//! tangential subproblem below is a strictly convex programme with an exact energy. The price
+//! is first-order resolution of the contact and stick ends (each lies within an element);
+//! graded meshes ([`Mesh::graded`], [`Mesh::symmetric`]) put small elements there.
+//!
+//! # Normal and electric subproblem (q fixed)
+//! On the set C of contact elements, with unknowns `p_C`, `g_C`, δz and φ0:
+//!
+//! ```text
+//! Uz_i − w_i δz + Z_i = 0          (zero gap, i ∈ C)
+//! Φ_i − w_i φ0 = 0                 (conducting punch: constant potential, i ∈ C)
+//! Σ w_j p_j = P,   Σ w_j g_j = Γ   (charge control; potential control fixes φ0 instead)
+//! ```
+//!
+//! The insulating punch and the elastic half-plane have `g = 0` and no potential rows. Under
+//! Goodman's approximation ([`Coupling::Goodman`]) the q terms are dropped from `Uz` and `Φ`.
+//! C is found by Kalker's active set (NORM): solve on C; drop every element with `p < 0`; else
+//! add every element outside C whose mean gap `(Uz_i − w_i δz + Z_i)/w_i` is negative (below
+//! −1e−9 of the profile height at the contact end); stop when neither happens. A set met
+//! before ends the search with the last set that had `p ≥ 0`.
+//!
+//! # Tangential subproblem (p and g fixed)
+//! With `U⁰` the element integrals of the previous step's `ux` (the slip reference) and
+//! `c = Ux(p, g) − U⁰`, the tractions minimise the incremental complementary energy
+//!
+//! ```text
+//! J(q) = ½ qᵀK q + cᵀq   subject to   −ηp_i ≤ q_i ≤ ηp_i,   Σ w_i q_i = Q,
+//! ```
+//!
+//! over the contact elements. Its KKT conditions are Coulomb's law: the multiplier of the
+//! equality is the increment of δx, and `(∂J/∂q_i)/w_i − Δδx` is the element's mean slip,
+//! zero where `|q_i| < ηp_i`, `≤ 0` where `q_i = ηp_i` and `≥ 0` where `q_i = −ηp_i`. It is
+//! solved by the primal–dual active-set method (semismooth Newton on the complementarity
+//! conditions), warm-started from the previous working set; if that does not settle in 30
+//! iterations, by the primal active-set method, which decreases J monotonically and
+//! terminates.
+//!
+//! # Alternation
+//! When q changes p or g (`w12 ≠ 0`, or `w13 ≠ 0` under a conducting punch, and full
+//! coupling), the two subproblems alternate until p and q change by less than
+//! [`Options::tolerance`] (relative to max p and η max p). After [`Options::freeze_after`]
+//! outer iterations elements may leave the contact but not enter it, so that an element at a
+//! contact end cannot cycle between states. Matrix factorizations are reused while the element
+//! sets that define them are unchanged.
+//!
+//! # Resolution
+//! Contact and stick-zone ends lie within one element (a stick run ends at an element edge;
+//! an element that a stick end crosses slips). The pressure converges at second order in the
+//! element size away from the contact ends and at order ½ in the end element, where
+//! `p ~ √(a − x)`. Path-dependent results (the stick zone of incremental normal loading)
+//! converge at first order in the load step.
+//!
+//! # State
+//! [`GeneralState`] is plain data: the mesh, p, q, g, ux and the slip per element, the element
+//! states, δz, δx, φ0 and the loads. It is the slip reference of the next step; the influence
+//! matrices are rebuilt from the mesh by [`Solver::new`].
+
+pub mod influence;
+pub mod mesh;
+
+mod dense;
+mod normal;
+mod tangential;
+
+#[cfg(test)]
+mod tests;
+
+use std::f64::consts::PI;
+
+use faer::Mat;
+use serde::{Deserialize, Serialize};
+
+use super::{ContactModel, Coupling, Electrode};
+use crate::error::SolveFailure;
+use dense::Workspace;
+use influence::Influence;
+pub use mesh::{Focus, Mesh};
+use normal::{NormalInput, NormalSolution};
+use tangential::{Bound, Programme};
+
+/// State of one element after a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ElementState {
+    /// Not in contact (p = 0).
+    Exterior,
+    /// In contact with no incremental slip in the step (also at `|q| = ηp` if the slip is zero).
+    Stick,
+    /// Slipping along +x relative to the punch (`q = −ηp`).
+    SlipPositive,
+    /// Slipping along −x relative to the punch (`q = +ηp`).
+    SlipNegative,
+}
+
+/// The state after a step: plain data, the memory of the next step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GeneralState {
+    /// The elements.
+    pub mesh: Mesh,
+    /// Pressure p per element (Pa).
+    pub pressure: Vec<f64>,
+    /// Shear traction q on the half-plane per element (Pa).
+    pub shear: Vec<f64>,
+    /// Surface charge g per element (C/m²; zero without a conducting punch).
+    pub charge: Vec<f64>,
+    /// Mean tangential surface displacement ux per element (m), datum d.
+    pub displacement: Vec<f64>,
+    /// Incremental slip of the last step per element (m): the half-plane's displacement
+    /// relative to the punch, mean over the element.
+    pub slip: Vec<f64>,
+    /// Element states.
+    pub codes: Vec<ElementState>,
+    /// Rigid approach δz of the punch (m, into the solid), datum d.
+    pub approach: f64,
+    /// Rigid tangential displacement δx of the punch (m), datum d.
+    pub shift: f64,
+    /// Punch potential φ0 (V; zero without a conducting punch).
+    pub potential: f64,
+    /// The loads of the step.
+    pub loads: Loads,
+}
+
+/// The loads of a step.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Loads {
+    /// P (N/m).
+    pub normal: f64,
+    /// Q (N/m).
+    pub tangential: f64,
+    /// Γ (C/m) for [`Electrode::ConductingCharge`], φ0 (V) for
+    /// [`Electrode::ConductingPotential`], unused otherwise.
+    pub electric: f64,
+}
+
+/// Options of a step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// Outer iterations after which no element may enter the contact (the set may only
+    /// shrink), so that a contact-end element cannot cycle.
+    pub freeze_after: usize,
+    /// Maximum outer iterations.
+    pub max_outer: usize,
+    /// Outer tolerance on the change of p (relative to max p) and q (relative to η max p).
+    pub tolerance: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            freeze_after: 4,
+            max_outer: 60,
+            tolerance: 1e-8,
+        }
+    }
+}
+
+/// What a step did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepReport {
+    /// Outer (normal–tangential) iterations.
+    pub outer_iterations: usize,
+    /// Active-set iterations of the last normal and tangential subproblems.
+    pub normal_iterations: usize,
+    /// See [`StepReport::normal_iterations`].
+    pub tangential_iterations: usize,
+    /// Final outer change.
+    pub residual: f64,
+    /// Whether the normal active set returned to an earlier set (the contact end then sits
+    /// where the last admissible set put it).
+    pub normal_cycled: bool,
+}
+
+/// How the electric problem is posed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum ElectricControl {
+    /// No charge on the contact (elastic solid, insulating punch).
+    None,
+    /// Conducting punch with charge Γ (C/m).
+    Charge(f64),
+    /// Conducting punch at potential φ0 (V).
+    Potential(f64),
+}
+
+/// The coefficients the element equations use.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Coefficients {
+    pub y11: f64,
+    pub y22: f64,
+    pub w12: f64,
+    /// `(y23, y33, w13)` of a piezoelectric solid.
+    pub electric: Option<(f64, f64, f64)>,
+    /// Whether q enters the normal and electric equations (false: Goodman's approximation).
+    pub coupled: bool,
+    pub friction: f64,
+    pub radius: f64,
+}
+
+/// The solver for one model and mesh: the influence matrices, built once.
+#[derive(Debug, Clone)]
+pub struct Solver {
+    coefficients: Coefficients,
+    electrode: Electrode,
+    mesh: Mesh,
+    influence: Influence,
+    options: Options,
+}
+
+impl GeneralState {
+    /// The unloaded state on a mesh.
+    pub fn unloaded(mesh: Mesh) -> Self {
+        let n = mesh.len();
+        Self {
+            mesh,
+            pressure: vec![0.0; n],
+            shear: vec![0.0; n],
+            charge: vec![0.0; n],
+            displacement: vec![0.0; n],
+            slip: vec![0.0; n],
+            codes: vec![ElementState::Exterior; n],
+            approach: 0.0,
+            shift: 0.0,
+            potential: 0.0,
+            loads: Loads {
+                normal: 0.0,
+                tangential: 0.0,
+                electric: 0.0,
+            },
+        }
+    }
+
+    /// Maximal runs of elements with the same state: `(state, from, to)` (m).
+    pub fn zones(&self) -> Vec<(ElementState, f64, f64)> {
+        let mut out: Vec<(ElementState, f64, f64)> = Vec::new();
+        for (i, &code) in self.codes.iter().enumerate() {
+            let (x1, x2) = (self.mesh.edges[i], self.mesh.edges[i + 1]);
+            match out.last_mut() {
+                Some(last) if last.0 == code => last.2 = x2,
+                _ => out.push((code, x1, x2)),
+            }
+        }
+        out
+    }
+
+    /// The outer edges of the outermost contact elements `(lo, hi)` (m), if any is in contact.
+    pub fn contact_extent(&self) -> Option<(f64, f64)> {
+        let first = self
+            .codes
+            .iter()
+            .position(|&c| c != ElementState::Exterior)?;
+        let last = self
+            .codes
+            .iter()
+            .rposition(|&c| c != ElementState::Exterior)?;
+        Some((self.mesh.edges[first], self.mesh.edges[last + 1]))
+    }
+
+    /// Total length of the elements in a state (m).
+    pub fn length_of(&self, state: ElementState) -> f64 {
+        (0..self.mesh.len())
+            .filter(|&i| self.codes[i] == state)
+            .map(|i| self.mesh.width(i))
+            .sum()
+    }
+
+    /// `∫p dx` (N/m), `∫q dx` (N/m) and `∫g dx` (C/m) by the element values.
+    pub fn resultants(&self) -> (f64, f64, f64) {
+        let w = self.mesh.widths();
+        let dot = |v: &[f64]| v.iter().zip(&w).map(|(a, b)| a * b).sum::<f64>();
+        (dot(&self.pressure), dot(&self.shear), dot(&self.charge))
+    }
+}
+
+impl Solver {
+    /// A solver for a model on a mesh. The datum d should exceed a quarter of the mesh's
+    /// length, so that the tangential programme is strictly convex (module docs).
+    pub fn new(model: &ContactModel, mesh: Mesh, options: Options) -> Self {
+        let c = &model.compliance;
+        let electric = match model.electrode {
+            Electrode::None => None,
+            _ => c.electric.map(|e| (e.y23, e.y33, e.w13)),
+        };
+        let coefficients = Coefficients {
+            y11: c.y11,
+            y22: c.y22,
+            w12: c.w12,
+            electric,
+            coupled: model.coupling == Coupling::Full,
+            friction: model.friction,
+            radius: model.radius,
+        };
+        let influence = Influence::new(&mesh, model.reference_distance);
+        Self {
+            coefficients,
+            electrode: model.electrode,
+            mesh,
+            influence,
+            options,
+        }
+    }
+
+    /// The mesh.
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
+    fn electric_control(&self, loads: Loads) -> ElectricControl {
+        match (self.electrode, self.coefficients.electric) {
+            (Electrode::ConductingCharge { .. }, Some(_)) => {
+                ElectricControl::Charge(loads.electric)
+            }
+            (Electrode::ConductingPotential { .. }, Some(_)) => {
+                ElectricControl::Potential(loads.electric)
+            }
+            _ => ElectricControl::None,
+        }
+    }
+
+    /// Whether q changes p or g, so that the subproblems must be alternated.
+    fn alternates(&self, control: ElectricControl) -> bool {
+        let c = &self.coefficients;
+        let w13 = match control {
+            ElectricControl::None => 0.0,
+            _ => c.electric.map_or(0.0, |e| e.2),
+        };
+        c.coupled && c.friction > 0.0 && (c.w12 != 0.0 || w13 != 0.0)
+    }
+
+    /// The contact elements of the start of a step: the previous contact, or Hertz's width
+    /// with the pressure compliance of the electrode if there was none.
+    fn initial_contact(&self, previous: &GeneralState, loads: Loads) -> Vec<bool> {
+        let mut contact: Vec<bool> = previous.pressure.iter().map(|&p| p > 0.0).collect();
+        if !contact.iter().any(|&c| c) {
+            let c = &self.coefficients;
+            let ystar = match (self.electric_control(loads), c.electric) {
+                (ElectricControl::None, _) | (_, None) => c.y22,
+                (_, Some((y23, y33, _))) => c.y22 - y23 * y23 / y33,
+            };
+            let a = (2.0 * loads.normal * c.radius * ystar / PI).sqrt();
+            for (i, flag) in contact.iter_mut().enumerate() {
+                let (x1, x2) = (self.mesh.edges[i], self.mesh.edges[i + 1]);
+                *flag = x2.abs().min(x1.abs()) < a || (x1 <= 0.0 && x2 >= 0.0);
+            }
+        }
+        contact
+    }
+
+    /// One load step from `previous` (its tractions and displacements are the slip reference).
+    pub fn step(
+        &self,
+        previous: &GeneralState,
+        loads: Loads,
+    ) -> Result<(GeneralState, StepReport), SolveFailure> {
+        assert_eq!(
+            previous.mesh, self.mesh,
+            "the state belongs to another mesh"
+        );
+        let control = self.electric_control(loads);
+        let alternate = self.alternates(control);
+        let mut contact = self.initial_contact(previous, loads);
+        let mut q = previous.shear.clone();
+        let mut p_old = previous.pressure.clone();
+        let mut report = StepReport {
+            outer_iterations: 0,
+            normal_iterations: 0,
+            tangential_iterations: 0,
+            residual: 0.0,
+            normal_cycled: false,
+        };
+        let mut work = Workspace::default();
+        for outer in 0..self.options.max_outer {
+            let input = NormalInput {
+                mesh: &self.mesh,
+                influence: &self.influence,
+                coefficients: &self.coefficients,
+                shear: &q,
+                normal_load: loads.normal,
+                electric: control,
+                grow: outer < self.options.freeze_after,
+            };
+            let normal = normal::solve(&input, contact, &mut work)?;
+            let p_start = p_old.clone();
+            contact = normal.contact.clone();
+            let (q_new, tangential) = self.tangential(
+                previous,
+                &normal,
+                loads.tangential,
+                (&q, &p_start),
+                &mut work,
+            )?;
+            let pmax = normal.pressure.iter().cloned().fold(0.0, f64::max);
+            let dq = q_new
+                .iter()
+                .zip(&q)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            let dp = normal
+                .pressure
+                .iter()
+                .zip(&p_old)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            let change =
+                (dp / pmax).max(dq / (self.coefficients.friction * pmax).max(f64::MIN_POSITIVE));
+            report = StepReport {
+                outer_iterations: outer + 1,
+                normal_iterations: normal.iterations,
+                tangential_iterations: tangential.iterations,
+                residual: change,
+                normal_cycled: report.normal_cycled || normal.cycled,
+            };
+            q = q_new;
+            p_old.clone_from(&normal.pressure);
+            if !alternate || (outer > 0 && change < self.options.tolerance) {
+                return Ok((self.finish(previous, loads, normal, q, tangential), report));
+            }
+        }
+        Err(SolveFailure::NoConvergence {
+            what: "normal–tangential alternation",
+            iterations: self.options.max_outer,
+            residual: report.residual,
+        })
+    }
+}
+
+/// The tangential subproblem's result on every element.
+struct Tangential {
+    slip: Vec<f64>,
+    /// `None` out of contact.
+    status: Vec<Option<Bound>>,
+    shift: f64,
+    tolerance: f64,
+    iterations: usize,
+}
+
+impl Solver {
+    /// The displacement `∫ux` per element of the pressure and charge (module docs, (U)).
+    fn fixed_displacement(&self, pressure: &[f64], charge: &[f64]) -> Vec<f64> {
+        let n = self.mesh.len();
+        let c = &self.coefficients;
+        let mut sp = vec![0.0; n];
+        self.influence.sign_apply(pressure, &mut sp);
+        let mut out: Vec<f64> = sp.iter().map(|v| -0.5 * c.w12 * v).collect();
+        if let Some((_, _, w13)) = c.electric {
+            let mut sg = vec![0.0; n];
+            self.influence.sign_apply(charge, &mut sg);
+            for (o, v) in out.iter_mut().zip(&sg) {
+                *o -= 0.5 * w13 * v;
+            }
+        }
+        out
+    }
+
+    /// The tangential subproblem at the pressure and charge of `normal`, with the previous
+    /// state's displacement as the slip reference, started from `start`.
+    fn tangential(
+        &self,
+        previous: &GeneralState,
+        normal: &NormalSolution,
+        total: f64,
+        (start, start_pressure): (&[f64], &[f64]),
+        work: &mut Workspace,
+    ) -> Result<(Vec<f64>, Tangential), SolveFailure> {
+        let n = self.mesh.len();
+        let c = &self.coefficients;
+        let act: Vec<usize> = (0..n).filter(|&i| normal.contact[i]).collect();
+        let mut q = vec![0.0; n];
+        let mut out = Tangential {
+            slip: vec![0.0; n],
+            status: (0..n)
+                .map(|i| normal.contact[i].then_some(Bound::Free))
+                .collect(),
+            shift: 0.0,
+            tolerance: 0.0,
+            iterations: 0,
+        };
+        if c.friction == 0.0 {
+            if total != 0.0 {
+                return Err(SolveFailure::NoAdmissibleState {
+                    reason: format!("gross slip: Q = {total:.6e} N/m on a frictionless contact"),
+                });
+            }
+            return Ok((q, out));
+        }
+        let fixed = self.fixed_displacement(&normal.pressure, &normal.charge);
+        let k = Mat::<f64>::from_fn(act.len(), act.len(), |r, s| {
+            -(c.y11 / PI) * self.influence.log[(act[r], act[s])]
+        });
+        let w: Vec<f64> = act.iter().map(|&i| self.mesh.width(i)).collect();
+        let lin: Vec<f64> = act
+            .iter()
+            .zip(&w)
+            .map(|(&i, w)| fixed[i] - previous.displacement[i] * w)
+            .collect();
+        let bound: Vec<f64> = act
+            .iter()
+            .map(|&i| c.friction * normal.pressure[i])
+            .collect();
+        let begin: Vec<f64> = act.iter().map(|&i| start[i]).collect();
+        // The working set of the start: elements at the friction limit of the start traction
+        // and the previous pressure keep their bound.
+        let begin_status: Vec<Bound> = act
+            .iter()
+            .map(|&i| {
+                let u = c.friction * start_pressure[i];
+                if u > 0.0 && start[i] >= u * (1.0 - 1e-9) {
+                    Bound::Upper
+                } else if u > 0.0 && start[i] <= -u * (1.0 - 1e-9) {
+                    Bound::Lower
+                } else {
+                    Bound::Free
+                }
+            })
+            .collect();
+        let programme = Programme {
+            k: &k,
+            c: &lin,
+            w: &w,
+            bound: &bound,
+            total,
+            elements: &act,
+        };
+        let m = tangential::minimise(&programme, &begin, &begin_status, work)?;
+        for (r, &i) in act.iter().enumerate() {
+            q[i] = m.q[r];
+            out.slip[i] = m.slip[r];
+            out.status[i] = Some(m.status[r]);
+        }
+        out.shift = m.shift;
+        out.tolerance = m.slip_tolerance;
+        out.iterations = m.iterations;
+        Ok((q, out))
+    }
+
+    /// The new state from the converged subproblems.
+    fn finish(
+        &self,
+        previous: &GeneralState,
+        loads: Loads,
+        normal: NormalSolution,
+        shear: Vec<f64>,
+        tangential: Tangential,
+    ) -> GeneralState {
+        let n = self.mesh.len();
+        let c = &self.coefficients;
+        let mut ux = self.fixed_displacement(&normal.pressure, &normal.charge);
+        let mut lq = vec![0.0; n];
+        self.influence.log_apply(&shear, &mut lq);
+        for (i, u) in ux.iter_mut().enumerate() {
+            *u = (*u - (c.y11 / PI) * lq[i]) / self.mesh.width(i);
+        }
+        let tol = tangential.tolerance;
+        let codes = (0..n)
+            .map(|i| {
+                let s = tangential.slip[i];
+                match tangential.status[i] {
+                    None => ElementState::Exterior,
+                    Some(Bound::Upper) if s < -tol => ElementState::SlipNegative,
+                    Some(Bound::Lower) if s > tol => ElementState::SlipPositive,
+                    Some(_) => ElementState::Stick,
+                }
+            })
+            .collect();
+        GeneralState {
+            mesh: self.mesh.clone(),
+            pressure: normal.pressure,
+            shear,
+            charge: normal.charge,
+            displacement: ux,
+            slip: tangential.slip,
+            codes,
+            approach: normal.approach,
+            shift: previous.shift + tangential.shift,
+            potential: normal.potential,
+            loads,
+        }
+    }
+}

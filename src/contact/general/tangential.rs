@@ -1,0 +1,406 @@
+//! The tangential subproblem at fixed pressure and charge (module docs of [`super`]): a
+//! strictly convex quadratic programme with box constraints and one equality, solved by a
+//! primal active-set method (Nocedal & Wright, *Numerical Optimization*, Algorithm 16.3).
+
+use faer::Mat;
+
+use super::dense::{Factored, Workspace};
+use super::influence::dot;
+
+use crate::error::SolveFailure;
+
+/// The programme `min ½ qᵀK q + cᵀq` subject to `−u ≤ q ≤ u` and `wᵀq = Q`, on the contact
+/// elements.
+pub(super) struct Programme<'a> {
+    /// `K` (symmetric positive definite), contact elements only.
+    pub k: &'a Mat<f64>,
+    /// `c`, the displacement of the fixed loads minus the reference, integrated per element.
+    pub c: &'a [f64],
+    /// Element widths `w`.
+    pub w: &'a [f64],
+    /// `u = η p ≥ 0`.
+    pub bound: &'a [f64],
+    /// Q (N/m).
+    pub total: f64,
+    /// The mesh indices of the contact elements (the key of the cached factorizations).
+    pub elements: &'a [usize],
+}
+
+/// Status of one element in the working set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Bound {
+    Free,
+    Upper,
+    Lower,
+}
+
+/// The minimiser with its multipliers.
+#[derive(Debug, Clone)]
+pub(super) struct Minimiser {
+    pub q: Vec<f64>,
+    /// Multiplier of `wᵀq = Q`: the rigid tangential displacement increment of the punch (m).
+    pub shift: f64,
+    /// Mean incremental slip per element, `(1/w)(∂J/∂q) − shift` (zero on free elements).
+    pub slip: Vec<f64>,
+    pub status: Vec<Bound>,
+    /// Slip below which an element counts as not slipping (m).
+    pub slip_tolerance: f64,
+    pub iterations: usize,
+}
+
+/// A feasible start near `start`: clip to the box, then spread `Q − wᵀq` over the elements in
+/// proportion to their room.
+fn feasible_start(p: &Programme, start: &[f64]) -> Result<Vec<f64>, SolveFailure> {
+    let mut q: Vec<f64> = start
+        .iter()
+        .zip(p.bound)
+        .map(|(q, u)| q.clamp(-u, *u))
+        .collect();
+    let excess = p.total - q.iter().zip(p.w).map(|(q, w)| q * w).sum::<f64>();
+    if excess == 0.0 {
+        return Ok(q);
+    }
+    let room: Vec<f64> = q
+        .iter()
+        .zip(p.bound)
+        .map(|(q, u)| if excess > 0.0 { u - q } else { q + u })
+        .collect();
+    let capacity: f64 = room.iter().zip(p.w).map(|(r, w)| r * w).sum();
+    if capacity <= excess.abs() {
+        let limit: f64 = p.bound.iter().zip(p.w).map(|(u, w)| u * w).sum();
+        return Err(SolveFailure::NoAdmissibleState {
+            reason: format!(
+                "gross slip: |Q| = {:.6e} N/m ≥ ηP = {limit:.6e} N/m",
+                p.total.abs()
+            ),
+        });
+    }
+    for (qi, r) in q.iter_mut().zip(&room) {
+        *qi += excess / capacity * r;
+    }
+    Ok(q)
+}
+
+fn status_of(q: &[f64], bound: &[f64]) -> Vec<Bound> {
+    q.iter()
+        .zip(bound)
+        .map(|(&q, &u)| {
+            if q >= u * (1.0 - 1e-13) {
+                Bound::Upper
+            } else if q <= -u * (1.0 - 1e-13) {
+                Bound::Lower
+            } else {
+                Bound::Free
+            }
+        })
+        .collect()
+}
+
+/// The equality-constrained step on the free set: `[K_FF −w_F; w_Fᵀ 0](d; λ) = (−∇_F; 0)`.
+fn free_step(
+    p: &Programme,
+    free: &[usize],
+    grad: &[f64],
+    work: &mut Workspace,
+) -> Result<(Vec<f64>, f64), SolveFailure> {
+    let m = free.len();
+    let cached = matches!(&work.tangential, Some((e, f, _)) if e.as_slice() == p.elements && f.as_slice() == free);
+    if !cached {
+        let mut a = Mat::<f64>::zeros(m + 1, m + 1);
+        for (r, &i) in free.iter().enumerate() {
+            for (s, &j) in free.iter().enumerate() {
+                a[(r, s)] = p.k[(i, j)];
+            }
+            a[(r, m)] = -p.w[i];
+            a[(m, r)] = p.w[i];
+        }
+        let f = Factored::new(a).ok_or(SolveFailure::NonFinite {
+            field: "tangential step matrix",
+        })?;
+        work.tangential = Some((p.elements.to_vec(), free.to_vec(), f));
+    }
+    let mut b = vec![0.0; m + 1];
+    for (r, &i) in free.iter().enumerate() {
+        b[r] = -grad[i];
+    }
+    let factored = &work.tangential.as_ref().expect("factored above").2;
+    let x = factored.solve(&b).ok_or(SolveFailure::NonFinite {
+        field: "tangential step",
+    })?;
+    Ok((x[..m].to_vec(), x[m]))
+}
+
+/// The minimiser, started from the working set `start` (the previous solution's): first by
+/// the primal–dual active-set method (a semismooth Newton method on the complementarity
+/// conditions, which changes many elements at once), then, if that does not settle within a
+/// few iterations or ends infeasible, by the primal active-set method, which terminates.
+pub(super) fn minimise(
+    p: &Programme,
+    start: &[f64],
+    start_status: &[Bound],
+    work: &mut Workspace,
+) -> Result<Minimiser, SolveFailure> {
+    let n = p.c.len();
+    // Slip scale: the largest mean displacement an admissible traction produces.
+    let scale = (0..n)
+        .map(|i| {
+            let col = p.k.col_as_slice(i);
+            col.iter()
+                .zip(p.bound)
+                .map(|(k, u)| k.abs() * u)
+                .sum::<f64>()
+                / p.w[i]
+        })
+        .fold(0.0, f64::max);
+    let tol = 1e-10 * scale;
+    if let Some(m) = primal_dual(p, start_status, tol, work)? {
+        return Ok(m);
+    }
+    primal(p, start, tol, work)
+}
+
+/// Primal–dual active set (Hintermüller, Ito & Kunisch 2003): fix the bound elements at their
+/// bounds, solve for the free ones with zero slip; a free element beyond its bound joins that
+/// bound, a bound element whose slip contradicts its friction is released; stop when nothing
+/// changes. `None` if it has not settled in 30 iterations or the free set empties.
+fn primal_dual(
+    p: &Programme,
+    start: &[Bound],
+    tol: f64,
+    work: &mut Workspace,
+) -> Result<Option<Minimiser>, SolveFailure> {
+    let n = p.c.len();
+    let mut status = start.to_vec();
+    for iteration in 1..=30 {
+        let free: Vec<usize> = (0..n).filter(|&i| status[i] == Bound::Free).collect();
+        if free.is_empty() {
+            return Ok(None);
+        }
+        let mut q: Vec<f64> = (0..n)
+            .map(|i| match status[i] {
+                Bound::Upper => p.bound[i],
+                Bound::Lower => -p.bound[i],
+                Bound::Free => 0.0,
+            })
+            .collect();
+        // Make the equality hold through the free elements: Q − (bound part) on them.
+        let bound_part: f64 = q.iter().zip(p.w).map(|(q, w)| q * w).sum();
+        let mut grad: Vec<f64> = (0..n)
+            .map(|i| dot(p.k.col_as_slice(i), &q) + p.c[i])
+            .collect();
+        let wf: f64 = free.iter().map(|&i| p.w[i] * p.w[i]).sum();
+        // A particular free traction meeting the equality, then the free step from it.
+        let t = (p.total - bound_part) / wf;
+        for &i in &free {
+            q[i] = t * p.w[i];
+        }
+        for &i in &free {
+            axpy(&mut grad, t * p.w[i], p.k.col_as_slice(i));
+        }
+        let (d, shift) = free_step(p, &free, &grad, work)?;
+        for (k, &i) in free.iter().enumerate() {
+            q[i] += d[k];
+            axpy(&mut grad, d[k], p.k.col_as_slice(i));
+        }
+        let slip: Vec<f64> = (0..n)
+            .map(|i| match status[i] {
+                Bound::Free => 0.0,
+                _ => grad[i] / p.w[i] - shift,
+            })
+            .collect();
+        let mut changed = false;
+        for i in 0..n {
+            let next = match status[i] {
+                Bound::Free if q[i] > p.bound[i] => Bound::Upper,
+                Bound::Free if q[i] < -p.bound[i] => Bound::Lower,
+                Bound::Upper if slip[i] > tol => Bound::Free,
+                Bound::Lower if slip[i] < -tol => Bound::Free,
+                s => s,
+            };
+            changed |= next != status[i];
+            status[i] = next;
+        }
+        if !changed {
+            return Ok(Some(Minimiser {
+                q,
+                shift,
+                slip,
+                status,
+                slip_tolerance: tol,
+                iterations: iteration,
+            }));
+        }
+    }
+    Ok(None)
+}
+
+/// The primal active-set method from a start near `start`. Each iteration either moves to the
+/// minimiser on the current free set (stopping at the first bound met, which joins the working
+/// set) or, at that minimiser, releases the bound element whose slip most contradicts its
+/// friction. The objective decreases strictly on every step that moves, so the method
+/// terminates (barring degeneracy, guarded by an iteration limit).
+fn primal(
+    p: &Programme,
+    start: &[f64],
+    tol: f64,
+    work: &mut Workspace,
+) -> Result<Minimiser, SolveFailure> {
+    let n = p.c.len();
+    let mut q = feasible_start(p, start)?;
+    let mut status = status_of(&q, p.bound);
+    let limit = 20 * n + 20;
+    for iteration in 1..=limit {
+        let mut grad: Vec<f64> = (0..n)
+            .map(|i| dot(p.k.col_as_slice(i), &q) + p.c[i])
+            .collect();
+        let free: Vec<usize> = (0..n).filter(|&i| status[i] == Bound::Free).collect();
+        let shift = if free.is_empty() {
+            shift_without_free(p, &grad, &status)
+        } else {
+            let (d, shift) = free_step(p, &free, &grad, work)?;
+            let mut alpha = 1.0;
+            let mut blocking = None;
+            for (k, &i) in free.iter().enumerate() {
+                let to = if d[k] > 0.0 {
+                    (p.bound[i] - q[i]) / d[k]
+                } else if d[k] < 0.0 {
+                    (-p.bound[i] - q[i]) / d[k]
+                } else {
+                    f64::INFINITY
+                };
+                if to < alpha {
+                    alpha = to.max(0.0);
+                    blocking = Some((i, d[k] > 0.0));
+                }
+            }
+            for (k, &i) in free.iter().enumerate() {
+                q[i] += alpha * d[k];
+                axpy(&mut grad, alpha * d[k], p.k.col_as_slice(i));
+            }
+            if let Some((i, up)) = blocking {
+                q[i] = if up { p.bound[i] } else { -p.bound[i] };
+                status[i] = if up { Bound::Upper } else { Bound::Lower };
+                continue;
+            }
+            shift
+        };
+        let slip: Vec<f64> = (0..n)
+            .map(|i| match status[i] {
+                Bound::Free => 0.0,
+                _ => grad[i] / p.w[i] - shift,
+            })
+            .collect();
+        // At q = +u the half-plane must slip along −x relative to the punch (s ≤ 0), at −u
+        // along +x.
+        let worst = (0..n)
+            .filter_map(|i| match status[i] {
+                Bound::Upper if slip[i] > tol => Some((i, slip[i])),
+                Bound::Lower if slip[i] < -tol => Some((i, -slip[i])),
+                _ => None,
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        match worst {
+            Some((i, _)) => status[i] = Bound::Free,
+            None => {
+                return Ok(Minimiser {
+                    q,
+                    shift,
+                    slip,
+                    status,
+                    slip_tolerance: tol,
+                    iterations: iteration,
+                });
+            }
+        }
+    }
+    Err(SolveFailure::NoConvergence {
+        what: "tangential active set",
+        iterations: limit,
+        residual: f64::NAN,
+    })
+}
+
+/// With every element at a bound the shift is any value in `[max over upper of ∇/w, min over
+/// lower of ∇/w]`; take the middle of that interval (or of the violated one, which then
+/// releases an element).
+fn shift_without_free(p: &Programme, grad: &[f64], status: &[Bound]) -> f64 {
+    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+    for (i, s) in status.iter().enumerate() {
+        let v = grad[i] / p.w[i];
+        match s {
+            Bound::Upper => lo = lo.max(v),
+            Bound::Lower => hi = hi.min(v),
+            Bound::Free => {}
+        }
+    }
+    match (lo.is_finite(), hi.is_finite()) {
+        (true, true) => 0.5 * (lo + hi),
+        (true, false) => lo,
+        (false, true) => hi,
+        (false, false) => 0.0,
+    }
+}
+
+/// `y += a x`.
+fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    for (y, x) in y.iter_mut().zip(x) {
+        *y += a * x;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::general::influence::Influence;
+    use crate::contact::general::mesh::Mesh;
+
+    /// Both methods reach the same minimiser of a programme with slip zones of both signs, and
+    /// it satisfies the KKT conditions (Coulomb's law) to the slip tolerance.
+    #[test]
+    fn primal_and_primal_dual_agree_and_satisfy_coulomb() {
+        let mesh = Mesh::uniform(-1.0, 1.0, 40);
+        let inf = Influence::new(&mesh, 10.0);
+        let n = mesh.len();
+        let k = Mat::<f64>::from_fn(n, n, |i, j| -inf.log[(i, j)] / std::f64::consts::PI);
+        let x = mesh.centres();
+        let w = mesh.widths();
+        // A linear term that drives opposite slips at the two ends, and Hertzian bounds.
+        let c: Vec<f64> = x.iter().zip(&w).map(|(x, w)| w * 0.3 * x * x * x).collect();
+        let bound: Vec<f64> = x.iter().map(|x| 0.3 * (1.0 - x * x).sqrt()).collect();
+        let elements: Vec<usize> = (0..n).collect();
+        let p = Programme {
+            k: &k,
+            c: &c,
+            w: &w,
+            bound: &bound,
+            total: 0.1,
+            elements: &elements,
+        };
+        let tol = 1e-12;
+        let a = primal(&p, &vec![0.0; n], tol, &mut Workspace::default()).unwrap();
+        let b = primal_dual(&p, &vec![Bound::Free; n], tol, &mut Workspace::default())
+            .unwrap()
+            .expect("settles");
+        let diff =
+            a.q.iter()
+                .zip(&b.q)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max);
+        assert!(diff < 1e-10, "{diff}");
+        assert!((a.shift - b.shift).abs() < 1e-10);
+        for m in [&a, &b] {
+            let total: f64 = m.q.iter().zip(&w).map(|(q, w)| q * w).sum();
+            assert!((total - 0.1).abs() < 1e-12);
+            for (i, u) in bound.iter().enumerate() {
+                assert!(m.q[i].abs() <= u * (1.0 + 1e-12));
+                match m.status[i] {
+                    Bound::Upper => assert!(m.slip[i] <= tol),
+                    Bound::Lower => assert!(m.slip[i] >= -tol),
+                    Bound::Free => assert!(m.q[i].abs() < *u),
+                }
+            }
+            assert!(m.status.contains(&Bound::Upper) && m.status.contains(&Bound::Lower));
+            assert!(m.status.contains(&Bound::Free));
+        }
+    }
+}
