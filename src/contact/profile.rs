@@ -37,6 +37,14 @@ impl Profile {
         }
     }
 
+    /// `∫ h dx` from `x1` to `x2` (m²): the mean gap of an element of the general solver times
+    /// its width.
+    pub fn gap_integral(&self, x1: f64, x2: f64) -> f64 {
+        match *self {
+            Self::Cylinder { radius } => (x2.powi(3) - x1.powi(3)) / (6.0 * radius),
+        }
+    }
+
     /// The slope h'(x) (–).
     pub fn slope(&self, x: f64) -> f64 {
         match *self {
@@ -78,5 +86,9 @@ mod tests {
             assert!((curvature - p.curvature()).abs() <= 1e-9 * p.curvature());
         }
         assert!(p.gap(0.0).abs() < f64::MIN_POSITIVE);
+        // The integral by Simpson's rule, exact for a parabola.
+        let (x1, x2) = (-1e-5, 3e-5);
+        let simpson = (x2 - x1) / 6.0 * (p.gap(x1) + 4.0 * p.gap(0.5 * (x1 + x2)) + p.gap(x2));
+        assert!((p.gap_integral(x1, x2) - simpson).abs() <= 1e-15 * simpson);
     }
 }

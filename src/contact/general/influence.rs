@@ -81,11 +81,6 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(a, b)| a * b).sum()
 }
 
-/// `∫_{x1}^{x2} x²/(2R) dx`: the element integral of the punch profile.
-pub fn profile_integral(x1: f64, x2: f64, radius: f64) -> f64 {
-    (x2.powi(3) - x1.powi(3)) / (6.0 * radius)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

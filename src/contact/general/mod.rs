@@ -236,7 +236,7 @@ pub(crate) struct Coefficients {
     /// Whether q enters the normal and electric equations (false: Goodman's approximation).
     pub coupled: bool,
     pub friction: f64,
-    pub radius: f64,
+    pub profile: crate::contact::Profile,
 }
 
 /// The solver for one model and mesh: the influence matrices, built once.
@@ -330,7 +330,7 @@ impl Solver {
             electric,
             coupled: model.coupling == Coupling::Full,
             friction: model.friction,
-            radius: model.radius,
+            profile: model.profile,
         };
         let influence = Influence::new(&mesh, model.reference_distance);
         Self {
@@ -379,7 +379,7 @@ impl Solver {
                 (ElectricControl::None, _) | (_, None) => c.y22,
                 (_, Some((y23, y33, _))) => c.y22 - y23 * y23 / y33,
             };
-            let a = (2.0 * loads.normal * c.radius * ystar / PI).sqrt();
+            let a = (2.0 * loads.normal * ystar / (c.profile.curvature() * PI)).sqrt();
             for (i, flag) in contact.iter_mut().enumerate() {
                 let (x1, x2) = (self.mesh.edges[i], self.mesh.edges[i + 1]);
                 *flag = x2.abs().min(x1.abs()) < a || (x1 <= 0.0 && x2 >= 0.0);

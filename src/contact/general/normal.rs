@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 use faer::Mat;
 
 use super::dense::{Factored, Workspace};
-use super::influence::{Influence, profile_integral};
+use super::influence::Influence;
 use super::mesh::Mesh;
 use super::{Coefficients, ElectricControl};
 use crate::error::SolveFailure;
@@ -78,7 +78,7 @@ pub(super) fn solve(
         // Gap tolerance: 1e−9 of the profile height at the outermost contact element.
         let scale = (0..n)
             .filter(|&i| contact[i])
-            .map(|i| input.mesh.centre(i).powi(2) / (2.0 * input.coefficients.radius))
+            .map(|i| input.coefficients.profile.gap(input.mesh.centre(i)))
             .fold(0.0, f64::max);
         let tol = 1e-9 * scale;
         let penetrating: Vec<usize> = (0..n).filter(|&i| !contact[i] && gaps[i] < -tol).collect();
@@ -122,7 +122,7 @@ fn gaps(input: &NormalInput, sol: &NormalSolution) -> Vec<f64> {
             let (x1, x2) = (input.mesh.edges[i], input.mesh.edges[i + 1]);
             let w = x2 - x1;
             let uz = -(c.y22 / PI) * lp[i] - (y23 / PI) * lg[i] + 0.5 * c.w12 * sq[i];
-            (uz - w * sol.approach + profile_integral(x1, x2, c.radius)) / w
+            (uz - w * sol.approach + c.profile.gap_integral(x1, x2)) / w
         })
         .collect()
 }
@@ -166,7 +166,7 @@ fn solve_on(
             }
         }
         a[(r, col_dz)] = -w;
-        b[r] = -profile_integral(x1, x2, c.radius) - 0.5 * c.w12 * sq[i];
+        b[r] = -c.profile.gap_integral(x1, x2) - 0.5 * c.w12 * sq[i];
         if has_g {
             b[m + r] = -0.5 * w13 * sq[i];
             match input.electric {

@@ -3,9 +3,15 @@
 
 use super::*;
 use crate::analytical::{CattaneoMindlin, Hertz, spence_stick_ratio};
+use crate::contact::Profile;
 use crate::contact::normal::{NormalOptions, solve_normal};
 use crate::contact::pressure::Discretisation;
 use crate::material::{ALUMINIUM, IsotropicConstants, Material};
+
+/// The punch radius R of a cylinder model (1/h'').
+fn radius_of(model: &ContactModel) -> f64 {
+    1.0 / model.profile.curvature()
+}
 
 /// Aluminium's shear modulus with Poisson's ratio ν, R = 10 mm.
 fn elastic(nu: f64, friction: f64, coupling: Coupling) -> ContactModel {
@@ -15,7 +21,7 @@ fn elastic(nu: f64, friction: f64, coupling: Coupling) -> ContactModel {
     };
     ContactModel::new(
         Material::Elastic(constants),
-        10e-3,
+        Profile::cylinder(10e-3),
         friction,
         Electrode::None,
     )
@@ -82,7 +88,7 @@ fn element_mean(mesh: &Mesh, i: usize, f: impl Fn(f64) -> f64) -> f64 {
 fn hertz_half_width_peak_pressure_and_profile() {
     let model = elastic(0.3, 0.0, Coupling::Full);
     let p = 2240.0;
-    let hertz = Hertz::new(p, model.radius, model.compliance.y22);
+    let hertz = Hertz::new(p, radius_of(&model), model.compliance.y22);
     let a = hertz.half_width;
     let mut peak_errors = Vec::new();
     let mut profile_errors = Vec::new();
@@ -137,7 +143,7 @@ fn cattaneo_mindlin_and_mindlin_deresiewicz_stick_zones_and_tractions() {
     let model = elastic(0.5, 0.3, Coupling::Full);
     assert!(model.compliance.w12.abs() < 1e-30);
     let p = 2240.0;
-    let hertz = Hertz::new(p, model.radius, model.compliance.y22);
+    let hertz = Hertz::new(p, radius_of(&model), model.compliance.y22);
     let a = hertz.half_width;
     let exact = CattaneoMindlin::new(hertz, 0.3, p);
     let (q_star, q_back) = (0.5 * 0.3 * p, -0.2 * 0.3 * p);
@@ -230,7 +236,7 @@ fn spence_stick_ratio_goodman_and_full_coupling() {
     let p = 2240.0;
     for coupling in [Coupling::Goodman, Coupling::Full] {
         let model = elastic(0.3, 0.3, coupling);
-        let a = Hertz::new(p, model.radius, model.compliance.y22).half_width;
+        let a = Hertz::new(p, radius_of(&model), model.compliance.y22).half_width;
         let mesh = graded_stick(a, 1e-3);
         let coarse = spence_stick_ratio_by_steps(&model, mesh.clone(), p, 1.02);
         let fine = spence_stick_ratio_by_steps(&model, mesh.clone(), p, 1.01);
@@ -283,7 +289,7 @@ fn pzt4_conducting_punch_zhou_lee_and_baseline_stick_zone() {
     let model = |friction| {
         ContactModel::new(
             Material::Piezoelectric(PZT4),
-            radius,
+            Profile::cylinder(radius),
             friction,
             Electrode::ConductingCharge { charge: gamma },
         )
@@ -373,7 +379,7 @@ fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
 fn state_round_trips_through_json() {
     let model = elastic(0.3, 0.3, Coupling::Full);
     let p = 2240.0;
-    let a = Hertz::new(p, model.radius, model.compliance.y22).half_width;
+    let a = Hertz::new(p, radius_of(&model), model.compliance.y22).half_width;
     let solver = Solver::new(&model, graded(a, 4e-3, 4e-2), Options::default());
     let (s0, _) = solver
         .step(
@@ -414,7 +420,12 @@ fn coupled_reversal_forms_old_direction_layers_at_the_ends() {
     use ElementState::*;
     let (p, gamma, radius, eta) = (2000.0, 6e-7, 0.06, 0.1);
     let electrode = Electrode::ConductingCharge { charge: gamma };
-    let model = ContactModel::new(Material::Piezoelectric(PZT4), radius, eta, electrode);
+    let model = ContactModel::new(
+        Material::Piezoelectric(PZT4),
+        Profile::cylinder(radius),
+        eta,
+        electrode,
+    );
     let c = model.compliance;
     let exact = ZhouLee::new(
         p,
@@ -483,8 +494,14 @@ fn coupled_reversal_forms_old_direction_layers_at_the_ends() {
 fn potential_control_and_insulating_punch() {
     use crate::material::PZT4;
     let (p, gamma, radius) = (2000.0, 6e-7, 0.06);
-    let model =
-        |electrode| ContactModel::new(Material::Piezoelectric(PZT4), radius, 0.3, electrode);
+    let model = |electrode| {
+        ContactModel::new(
+            Material::Piezoelectric(PZT4),
+            Profile::cylinder(radius),
+            0.3,
+            electrode,
+        )
+    };
     let charged = model(Electrode::ConductingCharge { charge: gamma });
     let c = charged.compliance;
     let a = Hertz::new(p, radius, c.pressure_compliance()).half_width;
