@@ -340,8 +340,49 @@ fn steady_cycle(c: &mut Criterion) {
     bench_cycle(c, "cycle/repeated_cycle", 2);
 }
 
+/// One tangential step of the general element solver on the default contact (PZT-4,
+/// conducting punch, η = 0.3, P = 2000 N/m): elements of 5e−4 a at the contact ends growing
+/// by 8 % to 1e−2 a inside, after an incremental normal loading with P and Γ rising together;
+/// the step takes Q from 0 to 0.05 ηP. Issue 37's target for it is 20 ms.
+fn general_step(c: &mut Criterion) {
+    use fretsim::contact::general::mesh::{Focus, Mesh};
+    use fretsim::contact::general::{GeneralState, Loads, Options, Solver};
+    let sc = default_scenario();
+    let disc = Discretisation::new(64);
+    let normal = solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
+    let a = normal.state.half_width;
+    let gamma = normal.state.charge;
+    let focus = [Focus {
+        at: a,
+        size: 5e-4 * a,
+    }];
+    let solver = Solver::new(
+        &sc.model,
+        Mesh::symmetric(1.1 * a, &focus, 1.08, 1e-2 * a),
+        Options::default(),
+    );
+    let at = |f: f64, q: f64| Loads {
+        normal: sc.normal_load * f,
+        tangential: q,
+        electric: gamma * f,
+    };
+    let mut state = GeneralState::unloaded(solver.mesh().clone());
+    for k in 1..=20 {
+        let f = k as f64 / 20.0;
+        state = solver.step(&state, at(f * f, 0.0)).unwrap().0;
+    }
+    let q = 0.05 * sc.model.friction * sc.normal_load;
+    let mut g = c.benchmark_group("general/tangential_step");
+    g.sample_size(10);
+    g.bench_function(BenchmarkId::from_parameter(solver.mesh().len()), |b| {
+        b.iter(|| black_box(solver.step(&state, at(1.0, q)).unwrap()))
+    });
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    general_step,
     kernels,
     normal,
     steps,
