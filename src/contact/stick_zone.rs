@@ -1,0 +1,890 @@
+//! The stick zone `[lo, hi]` and its bounded correction q̃ ([`StickZone`]): its own series and
+//! centre kink, the chain of corrections it inherits from earlier zones ([`Inherited`]), and
+//! the piecewise Chebyshev tables (`ChainTable`) of q̃ and `H'q̃` that make a long chain cheap
+//! to evaluate.
+
+use serde::Serialize;
+
+use crate::quadrature::BoundedSeries;
+
+use super::inherited::sign_blend;
+use super::rules::{KnownSizes, SizeTables, built_once, piece_ends};
+use super::{
+    Inherited, half_ellipse, half_ellipse_cauchy, half_ellipse_integral, kink_cauchy, kink_density,
+};
+
+/// The stick zone `[lo, hi]` and the bounded correction `q̃` on it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StickZone {
+    /// Left end (m).
+    pub lo: f64,
+    /// Right end (m).
+    pub hi: f64,
+    /// Smooth part of `q̃((x − mid)/half)` (Pa).
+    pub correction: BoundedSeries,
+    /// Amplitude A of the kink part `A·k(u)` of q̃ (Pa), see [`kink_density`]; non-zero only
+    /// for the normal-loading state, whose memory `C|x|` has a kink at the centre.
+    pub kink: f64,
+    /// Correction inherited from the state that began the phase; it carries the exact
+    /// square-root structure of the memory at old stick ends (see [`Inherited`]).
+    #[serde(skip)]
+    pub inherited: Option<std::sync::Arc<Inherited>>,
+    /// The square-root coefficients `[k_lo, k_hi]` of the whole q̃ at the ends,
+    /// `q̃ ≈ k_lo √(x − lo)` and `q̃ ≈ k_hi √(hi − x)` (Pa/√m): they fix the kinks of p and w
+    /// here and, once the zone is remembered, at its ends inside later stick zones. Zero for a
+    /// zone solved without kinks (normal loading, uncoupled contacts).
+    pub end_roots: [f64; 2],
+    /// The slip signs beside the ends when the zone was solved (left, right).
+    pub end_signs: [f64; 2],
+    /// Closed-form parts of q̃ that carry the kinks of remembered stick ends inside the zone:
+    /// `amplitude · √((x − u)(v − x))` on `[u, v]`, as `(u, v, amplitude)` (tangential module
+    /// docs, "Kinks at the stick ends").
+    pub extras: Vec<(f64, f64, f64)>,
+    /// `H'q̃` tabulated once the zone begins a phase ([`StickZone::tabulate`]).
+    #[serde(skip)]
+    pub(super) cauchy_table: TableCache,
+    /// q̃ tabulated with it.
+    #[serde(skip)]
+    pub(super) value_table: TableCache,
+    /// `H'q̃` on the two outer pieces alone, `[lo − w, lo]` and `[hi, hi + w]` (w the zone's
+    /// width), for a zone without [`Self::tabulate`]'s table whose transform is wanted at many
+    /// points of the slip zones (`EXTERIOR_TABLE_POINTS`; the checks and increments of the
+    /// steps it ends and begins).
+    #[serde(skip)]
+    pub(super) exterior_table: TableCache<[ChainTable; 2]>,
+}
+
+/// `H'q̃` of a zone with its whole chain, interpolated piecewise: on each piece between the
+/// points where q̃ is not smooth (the zone's ends, its chain's zone ends and ramp points, a
+/// centre kink), and on two outer pieces of the zone's width on either side, by a Chebyshev
+/// series in the graded variable v (`x = mid + half sin(πv/2)`, which absorbs the square
+/// roots at the piece ends). Outside the outer pieces the transform is evaluated directly.
+/// The same form holds q̃ itself on the zone's pieces, less its centre kinks
+/// (`StickZone::chain_kinks`), for a zone with a chain: one sum of `M + 32` terms instead of
+/// one of M terms for every zone of the chain (in a steady cycle, four).
+#[derive(Debug, Clone, Default)]
+pub(super) struct ChainTable {
+    /// Piece ends, increasing.
+    ends: Vec<f64>,
+    /// Chebyshev coefficients in v, one series per piece.
+    coefficients: Vec<Vec<f64>>,
+}
+
+impl ChainTable {
+    /// The table of f on the pieces between `ends`, `nodes` Chebyshev points per piece in the
+    /// graded variable.
+    fn interpolating(ends: Vec<f64>, nodes: usize, f: impl Fn(f64) -> f64) -> Self {
+        Self::interpolating_batch(ends, nodes, |xs, out| out.extend(xs.iter().map(|&x| f(x))))
+    }
+
+    /// [`Self::interpolating`] with f evaluated at all the pieces' points in one call
+    /// (`f(xs, out)` pushes the values onto `out`, passed empty).
+    fn interpolating_batch(
+        ends: Vec<f64>,
+        nodes: usize,
+        f: impl FnOnce(&[f64], &mut Vec<f64>),
+    ) -> Self {
+        let ChebyshevPoints { v, transforms } = ChebyshevPoints::of(nodes);
+        let points: Vec<f64> = ends
+            .windows(2)
+            .flat_map(|w| {
+                let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+                v.iter()
+                    .map(move |v| mid + half * (std::f64::consts::FRAC_PI_2 * v).sin())
+            })
+            .collect();
+        let mut all = Vec::with_capacity(points.len());
+        f(&points, &mut all);
+        // The coefficients `c_j = (2 − δ_j0)/N Σ_k f_k cos(j θ_k)`: a discrete cosine transform.
+        let coefficients = all
+            .chunks_exact(nodes)
+            .map(|values| {
+                let mut c = vec![0.0; nodes];
+                c[0] = transforms.cosines(values, &mut c[1..]) / nodes as f64;
+                for cj in &mut c[1..] {
+                    *cj *= 2.0 / nodes as f64;
+                }
+                c
+            })
+            .collect();
+        Self { ends, coefficients }
+    }
+
+    /// The interpolated value at x, `None` outside the tabulated range.
+    fn at(&self, x: f64) -> Option<f64> {
+        let k = self.piece(x)?;
+        Some(crate::quadrature::chebyshev_t_sum(
+            &self.coefficients[k],
+            self.graded(k, x),
+        ))
+    }
+
+    /// The piece that holds x, `None` outside the tabulated range.
+    fn piece(&self, x: f64) -> Option<usize> {
+        let (first, last) = (*self.ends.first()?, *self.ends.last()?);
+        if !(x >= first && x <= last) {
+            return None;
+        }
+        Some(
+            self.ends
+                .partition_point(|e| *e <= x)
+                .clamp(1, self.ends.len() - 1)
+                - 1,
+        )
+    }
+
+    /// The graded variable v of x on piece k.
+    fn graded(&self, k: usize, x: f64) -> f64 {
+        let (mid, half) = (
+            0.5 * (self.ends[k] + self.ends[k + 1]),
+            0.5 * (self.ends[k + 1] - self.ends[k]),
+        );
+        ((x - mid) / half).clamp(-1.0, 1.0).asin() / std::f64::consts::FRAC_PI_2
+    }
+
+    /// [`Self::at`] at each of `xs` into `out`, `fallback(x)` outside the table (bit-identical;
+    /// eight, else four, consecutive points on one piece share one sum, their recurrences
+    /// interleaved, because the recurrences are latency-bound; each point's piece is found
+    /// once).
+    fn values_into(&self, xs: &[f64], fallback: impl Fn(f64) -> f64, out: &mut Vec<f64>) {
+        let pieces: Vec<Option<usize>> = xs.iter().map(|&x| self.piece(x)).collect();
+        let run = |k: usize, len: usize| {
+            pieces[k].is_some()
+                && k + len <= xs.len()
+                && pieces[k + 1..k + len].iter().all(|p| *p == pieces[k])
+        };
+        let mut k = 0;
+        while k < xs.len() {
+            match pieces[k] {
+                Some(p) if run(k, 8) => {
+                    let v: [f64; 8] = std::array::from_fn(|l| self.graded(p, xs[k + l]));
+                    out.extend(crate::quadrature::chebyshev_t_sums(
+                        &self.coefficients[p],
+                        v,
+                    ));
+                    k += 8;
+                }
+                Some(p) if run(k, 4) => {
+                    let v: [f64; 4] = std::array::from_fn(|l| self.graded(p, xs[k + l]));
+                    out.extend(crate::quadrature::chebyshev_t_sums(
+                        &self.coefficients[p],
+                        v,
+                    ));
+                    k += 4;
+                }
+                _ => {
+                    out.push(self.at(xs[k]).unwrap_or_else(|| fallback(xs[k])));
+                    k += 1;
+                }
+            }
+        }
+    }
+}
+
+/// The Chebyshev points `v_k = cos θ_k`, `θ_k = (2k+1)π/(2N)`, of a [`ChainTable`]'s pieces
+/// and the fast transform of its cosine sums, built once per N: computing the N² cosines for
+/// every table would cost far more than the transform that uses them.
+struct ChebyshevPoints {
+    v: Vec<f64>,
+    transforms: crate::transforms::HalfAngleTransforms,
+}
+
+impl ChebyshevPoints {
+    fn of(nodes: usize) -> &'static Self {
+        static POINTS: SizeTables<ChebyshevPoints> = std::sync::Mutex::new(Vec::new());
+        thread_local! {
+            static KNOWN: KnownSizes<ChebyshevPoints> =
+                const { std::cell::RefCell::new(Vec::new()) };
+        }
+        built_once(&POINTS, &KNOWN, nodes, |n| {
+            let theta = |k: usize| (2 * k + 1) as f64 * std::f64::consts::PI / (2 * n) as f64;
+            Self {
+                v: (0..n).map(|k| theta(k).cos()).collect(),
+                transforms: crate::transforms::HalfAngleTransforms::new(n),
+            }
+        })
+    }
+}
+
+/// A cache filled at most once that takes no part in comparisons.
+#[derive(Debug, Clone)]
+pub(super) struct TableCache<T = ChainTable>(std::sync::OnceLock<T>);
+
+impl<T> Default for TableCache<T> {
+    fn default() -> Self {
+        Self(std::sync::OnceLock::new())
+    }
+}
+
+impl<T> PartialEq for TableCache<T> {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+/// Chebyshev points per piece of a zone's exterior tables ([`StickZone::correction_cauchys_into`])
+/// for series of M terms: near a stick end the transform of an M-term series varies on a
+/// scale of about 1/M² of the zone, so the points grow with M. Measured against the direct
+/// sums on every accepted zone of four coupled histories (test
+/// `exterior_tables_match_the_direct_transform`): 64 points 1e−9 at M = 128 and 3e−8 at
+/// M = 256; M/2 + 32 points 2e−12 (1.2e−11 at worst), which still moved two step dissipations
+/// of the Figure-3 history at η = 0.2 by 2.2e−8 of themselves (the pair's sum unchanged: a
+/// state's strain enters one step as the new state and the next as the old); 3M/4 + 32 points
+/// 1.0e−9 of them (1.4e−10 of the largest step's), at 1.5 % of a forward step at M = 128.
+fn exterior_table_nodes(terms: usize) -> usize {
+    terms * 3 / 4 + 32
+}
+
+/// Points on the exterior pieces that make a batch of [`StickZone::correction_cauchys_into`]
+/// tabulate the transform there. A step's slip check asks for about 300 at M = 128, its
+/// dissipation about 500, and the next step's as many again of the same zone as the old
+/// state; the tables cost `2 exterior_table_nodes(M)` direct sums (256 at M = 128), so below
+/// this many points direct sums are cheaper and above it the table pays for itself.
+const EXTERIOR_TABLE_POINTS: usize = 128;
+
+/// The largest move of a fade ramp's points, relative to its length, over which an evaluation
+/// reuses a fade table built for the earlier ramps ([`Inherited::reusing_table_of`]).
+pub(super) const FADE_TABLE_REUSE: f64 = 1e-5;
+
+/// Collocation points a fade ramp over a short overlap must hold ([`StickZone::inheritance_for`]):
+/// enough for the series to absorb the ramp's shape. At M = 48 a quarter-overlap ramp with about
+/// five points made steps worse than leaving the remembered kink to the series.
+const FADE_POINTS: f64 = 6.0;
+
+/// Points whose Chebyshev sums are interleaved in the batched evaluations of a zone's own part
+/// ([`StickZone::own_parts_into`]) and of the contact's series
+/// ([`ContactState::pressures_into`] and the like): the Clenshaw recurrences are
+/// latency-bound, so eight independent points keep more of them in flight than four (sixteen
+/// gain nothing more), with the same bits.
+///
+/// [`ContactState::pressures_into`]: super::ContactState::pressures_into
+pub(super) const OWN_LANES: usize = 8;
+
+/// A zone's own part in one form (density or Cauchy transform): the series at
+/// [`OWN_LANES`] points, at one point, and the kink term ([`StickZone::own_parts_into`]).
+type OwnForms = (
+    fn(&BoundedSeries, [f64; OWN_LANES]) -> [f64; OWN_LANES],
+    fn(&BoundedSeries, f64) -> f64,
+    fn(f64) -> f64,
+);
+
+/// `f` at each of `xs` into `out`, L points at a time by `fl`, which must give `f`'s values
+/// bit for bit (the L-point Chebyshev sums of [`crate::quadrature`]).
+pub(super) fn in_chunks<const L: usize>(
+    xs: &[f64],
+    fl: impl Fn([f64; L]) -> [f64; L],
+    f: impl Fn(f64) -> f64,
+    out: &mut Vec<f64>,
+) {
+    out.clear();
+    let mut chunks = xs.chunks_exact(L);
+    for c in chunks.by_ref() {
+        out.extend(fl(std::array::from_fn(|l| c[l])));
+    }
+    out.extend(chunks.remainder().iter().map(|&x| f(x)));
+}
+
+impl StickZone {
+    /// A zone with its own correction only.
+    pub fn new(lo: f64, hi: f64, correction: BoundedSeries, kink: f64) -> Self {
+        Self {
+            lo,
+            hi,
+            correction,
+            kink,
+            inherited: None,
+            end_roots: [0.0; 2],
+            end_signs: [0.0; 2],
+            extras: Vec::new(),
+            cauchy_table: TableCache::default(),
+            value_table: TableCache::default(),
+            exterior_table: TableCache::default(),
+        }
+    }
+
+    /// The slip-shape S at x from the slip signs beside the ends when the zone was solved
+    /// (the smoothstep of [`ContactState::slip_shape`]).
+    ///
+    /// [`ContactState::slip_shape`]: super::ContactState::slip_shape
+    pub fn end_sign_shape(&self, x: f64) -> f64 {
+        sign_blend(self.end_signs, self.lo, self.hi, x)
+    }
+
+    /// Tabulate `H'q̃` and q̃ (see `ChainTable`) for a zone that will be evaluated many times
+    /// (one that a phase inherits from), with `nodes` Chebyshev points per piece. No-op if
+    /// already done.
+    pub fn tabulate(&self, nodes: usize) {
+        let width = self.hi - self.lo;
+        let slack = 1e-12 * width;
+        let mut inner = self.chain_points();
+        inner.retain(|&x| x > self.lo + slack && x < self.hi - slack);
+        self.cauchy_table.0.get_or_init(|| {
+            let mut points = vec![self.lo - width, self.lo, self.hi, self.hi + width];
+            points.extend(&inner);
+            ChainTable::interpolating(piece_ends(points), nodes, |x| self.direct_cauchy(x))
+        });
+        // A zone without a chain sums its own series faster than a table of more terms.
+        if self.inherited.is_none() {
+            return;
+        }
+        self.value_table.0.get_or_init(|| {
+            let mut points = vec![self.lo, self.hi];
+            points.extend(&inner);
+            let smooth = |x| self.direct_correction(x) - self.chain_kinks(x);
+            ChainTable::interpolating(piece_ends(points), nodes, smooth)
+        });
+    }
+
+    /// q̃ at x (Pa), including the inherited chain; zero outside the zone (the zones a chain
+    /// carries whole lie inside it, and the faded ones are faded out at its ends).
+    pub fn correction_at(&self, x: f64) -> f64 {
+        if !(x > self.lo && x < self.hi) {
+            return 0.0;
+        }
+        match self.value_table.0.get() {
+            Some(table) => table.at(x).unwrap_or(0.0) + self.chain_kinks(x),
+            None => self.direct_correction(x),
+        }
+    }
+
+    /// The centre kinks' part of q̃ at x inside the zone: `kink · k(u)` of every zone of the
+    /// chain that carries one, times the fades of the links above it. Its `u ln|u|` at the
+    /// kink point is left out of the value table, which interpolates the smooth rest (with it
+    /// the table was off by 1e−8 of the largest q̃ at the kink point, 2e−10 at 1e−3 of the
+    /// zone's width from it).
+    fn chain_kinks(&self, x: f64) -> f64 {
+        let own = |zone: &StickZone| {
+            if zone.kink.abs() > 0.0 && x > zone.lo && x < zone.hi {
+                zone.kink * kink_density((x - zone.mid()) / zone.half())
+            } else {
+                0.0
+            }
+        };
+        let mut total = own(self);
+        let mut fade = 1.0;
+        for link in self.links() {
+            if link.faded() {
+                fade *= link.chi(x);
+            }
+            total += fade * own(&link.zone);
+        }
+        total
+    }
+
+    /// [`Self::correction_at`] inside the zone from the series and the chain.
+    fn direct_correction(&self, x: f64) -> f64 {
+        self.own_part(x, BoundedSeries::density, kink_density)
+            + self.inherited.as_ref().map_or(0.0, |z| z.value(x))
+            + self.extras_with(|u, v| half_ellipse(x, u, v))
+    }
+
+    /// [`Self::correction_at`] at each of `xs` into `out` (bit-identical; the own series is
+    /// summed eight (`OWN_LANES`) points at a time, [`BoundedSeries::densities`], and the
+    /// chain in batches). q̃ is zero outside the zone, so only the points inside are
+    /// evaluated (the slip zones' points of a step's checks and integrals, the sample points
+    /// beyond the stick ends).
+    pub fn corrections_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        let inside = |x: f64| x > self.lo && x < self.hi;
+        if xs.iter().all(|&x| inside(x)) {
+            self.corrections_inside(xs, out);
+            return;
+        }
+        let points: Vec<f64> = xs.iter().copied().filter(|&x| inside(x)).collect();
+        let mut values = Vec::with_capacity(points.len());
+        self.corrections_inside(&points, &mut values);
+        let mut values = values.into_iter();
+        out.clear();
+        out.extend(xs.iter().map(|&x| {
+            if inside(x) {
+                values.next().expect("one value per point inside")
+            } else {
+                0.0
+            }
+        }));
+    }
+
+    /// [`Self::corrections_into`] at points that all lie inside the zone.
+    fn corrections_inside(&self, xs: &[f64], out: &mut Vec<f64>) {
+        if let Some(table) = self.value_table.0.get() {
+            table.values_into(xs, |_| 0.0, out);
+            for (o, &x) in out.iter_mut().zip(xs) {
+                *o = if x > self.lo && x < self.hi {
+                    *o + self.chain_kinks(x)
+                } else {
+                    0.0
+                };
+            }
+            return;
+        }
+        let many = BoundedSeries::densities::<OWN_LANES>;
+        self.own_parts_into(xs, (many, BoundedSeries::density, kink_density), out);
+        if let Some(link) = &self.inherited {
+            let mut inner = Vec::with_capacity(xs.len());
+            link.values_into(xs, &mut inner);
+            for (o, v) in out.iter_mut().zip(inner) {
+                *o += v;
+            }
+        }
+        for (o, &x) in out.iter_mut().zip(xs) {
+            *o = if x > self.lo && x < self.hi {
+                *o + self.extras_with(|u, v| half_ellipse(x, u, v))
+            } else {
+                0.0
+            };
+        }
+    }
+
+    /// [`Self::own_part`] at each of `xs` into `out` (bit-identical: the series [`OWN_LANES`]
+    /// points at a time by `many`, the rest by `one`; the kink term through `kink`).
+    fn own_parts_into(&self, xs: &[f64], (many, one, kink): OwnForms, out: &mut Vec<f64>) {
+        let (mid, half) = (self.mid(), self.half());
+        let own_many = |x: [f64; OWN_LANES]| {
+            let u = x.map(|x| (x - mid) / half);
+            let series = (!self.correction.beta.is_empty()).then(|| many(&self.correction, u));
+            std::array::from_fn(|l| self.own_with(u[l], series.map(|s| s[l]), kink))
+        };
+        in_chunks(xs, own_many, |x| self.own_part(x, one, kink), out);
+    }
+
+    /// [`Self::own_part`] at u from the series' term there (`None` when the zone has no
+    /// series) and the kink term through `kink`.
+    fn own_with(&self, u: f64, series: Option<f64>, kink: fn(f64) -> f64) -> f64 {
+        let mut own = 0.0;
+        if let Some(s) = series {
+            own += s;
+        }
+        if self.kink.abs() > 0.0 {
+            own += self.kink * kink(u);
+        }
+        own
+    }
+
+    /// `Σ amplitude · f(u, v)` over the closed-form extras.
+    fn extras_with(&self, f: impl Fn(f64, f64) -> f64) -> f64 {
+        self.extras.iter().map(|&(u, v, amp)| amp * f(u, v)).sum()
+    }
+
+    /// `H'q̃(x)` (Pa), including the inherited chain (from [`Self::tabulate`]'s table or the
+    /// exterior tables of [`Self::correction_cauchys_into`] when the zone has them).
+    pub fn correction_cauchy(&self, x: f64) -> f64 {
+        let table = match self.cauchy_table.0.get() {
+            Some(table) => table.at(x),
+            None => self
+                .exterior_table
+                .0
+                .get()
+                .and_then(|tables| tables.iter().find_map(|t| t.at(x))),
+        };
+        table.unwrap_or_else(|| self.direct_cauchy(x))
+    }
+
+    /// [`Self::correction_cauchy`] at each of `xs` into `out`, bit-identical (the own series
+    /// eight (`OWN_LANES`) points at a time, [`BoundedSeries::cauchys`], and the chain's fade
+    /// integrals in batches, [`Inherited::cauchy_into`]). A zone without [`Self::tabulate`]'s
+    /// table tabulates its transform on the outer pieces `[lo − w, lo]` and `[hi, hi + w]` (w
+    /// the zone's width) at the first call with at least `EXTERIOR_TABLE_POINTS` points there
+    /// (the slip zones' points of a step's checks and increments); from then on both forms
+    /// interpolate it on those pieces.
+    pub fn correction_cauchys_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        if let Some(table) = self.cauchy_table.0.get() {
+            table.values_into(xs, |x| self.direct_cauchy(x), out);
+            return;
+        }
+        let Some(tables) = self.exterior_tables(xs) else {
+            self.direct_cauchys_into(xs, out);
+            return;
+        };
+        // The points on the tables' pieces from the tables, the rest directly, each in one
+        // batch.
+        let mut on_table: [(Vec<usize>, Vec<f64>); 2] = Default::default();
+        let mut direct: (Vec<usize>, Vec<f64>) = Default::default();
+        for (k, &x) in xs.iter().enumerate() {
+            let into = match tables.iter().position(|t| t.piece(x).is_some()) {
+                Some(side) => &mut on_table[side],
+                None => &mut direct,
+            };
+            into.0.push(k);
+            into.1.push(x);
+        }
+        out.resize(xs.len(), 0.0);
+        let mut values = Vec::with_capacity(xs.len());
+        for (table, (at, points)) in tables.iter().zip(&on_table) {
+            values.clear();
+            table.values_into(
+                points,
+                |_| unreachable!("a point on the table"),
+                &mut values,
+            );
+            for (&k, &v) in at.iter().zip(&values) {
+                out[k] = v;
+            }
+        }
+        values.clear();
+        self.direct_cauchys_into(&direct.1, &mut values);
+        for (&k, &v) in direct.0.iter().zip(&values) {
+            out[k] = v;
+        }
+    }
+
+    /// The exterior tables (`exterior_table`), built here when `xs` has enough points on
+    /// their pieces; `None` without them.
+    fn exterior_tables(&self, xs: &[f64]) -> Option<&[ChainTable; 2]> {
+        if let Some(tables) = self.exterior_table.0.get() {
+            return Some(tables);
+        }
+        let width = self.hi - self.lo;
+        let outer =
+            |x: f64| (x >= self.lo - width && x < self.lo) || (x > self.hi && x <= self.hi + width);
+        if xs.iter().filter(|&&x| outer(x)).count() < EXTERIOR_TABLE_POINTS {
+            return None;
+        }
+        Some(self.exterior_table.0.get_or_init(|| {
+            let nodes = exterior_table_nodes(self.series_terms());
+            let table = |from: f64, to: f64| {
+                ChainTable::interpolating_batch(vec![from, to], nodes, |xs, out| {
+                    self.direct_cauchys_into(xs, out)
+                })
+            };
+            [
+                table(self.lo - width, self.lo),
+                table(self.hi, self.hi + width),
+            ]
+        }))
+    }
+
+    /// [`Self::correction_cauchys_into`] from the series and the chain (no table).
+    fn direct_cauchys_into(&self, xs: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        let many = BoundedSeries::cauchys::<OWN_LANES>;
+        self.own_parts_into(xs, (many, BoundedSeries::cauchy, kink_cauchy), out);
+        if let Some(link) = &self.inherited {
+            let mut inner = Vec::with_capacity(xs.len());
+            link.cauchy_into(xs, &mut inner);
+            for (o, v) in out.iter_mut().zip(inner) {
+                *o += v;
+            }
+        }
+        for (o, &x) in out.iter_mut().zip(xs) {
+            *o += self.extras_with(|u, v| half_ellipse_cauchy(x, u, v));
+        }
+    }
+
+    /// `H'q̃(x)` from the series and the chain.
+    fn direct_cauchy(&self, x: f64) -> f64 {
+        self.own_part(x, BoundedSeries::cauchy, kink_cauchy)
+            + self.inherited.as_ref().map_or(0.0, |z| z.cauchy(x))
+            + self.extras_with(|u, v| half_ellipse_cauchy(x, u, v))
+    }
+
+    /// The zone's own series and kink term through `series` and `kink` (density or Cauchy
+    /// transform); terms that are absent (no coefficients, no kink) are not evaluated.
+    fn own_part(
+        &self,
+        x: f64,
+        series: fn(&BoundedSeries, f64) -> f64,
+        kink: fn(f64) -> f64,
+    ) -> f64 {
+        let u = (x - self.mid()) / self.half();
+        let series = (!self.correction.beta.is_empty()).then(|| series(&self.correction, u));
+        self.own_with(u, series, kink)
+    }
+
+    /// Whether the zone carries nothing of its own: q̃ is exactly its inherited link's.
+    fn carries_nothing(&self) -> bool {
+        self.correction.beta.is_empty() && self.kink.abs() <= 0.0 && self.extras.is_empty()
+    }
+
+    /// `∫ q̃ dx` (N/m), including the inherited chain (the kink part is odd).
+    pub fn correction_integral(&self) -> f64 {
+        self.half() * self.correction.integral()
+            + self.inherited.as_ref().map_or(0.0, |z| z.integral())
+            + self.extras_with(half_ellipse_integral)
+    }
+
+    /// What a new zone `[lo, hi]` (solved on `nodes` collocation points) inherits from this
+    /// chain. The memory inside the new zone has square-root kinks exactly at the ends of
+    /// earlier zones that lie inside it (and a `|x|` kink at the centre of the normal-loading
+    /// zone): the outermost earlier zone that lies inside is inherited whole; one with a
+    /// single end inside is inherited faded out beyond the new zone's end; one that contains
+    /// the new zone is passed over for its inner zones, unless its own centre kink lies
+    /// inside.
+    ///
+    /// The fade ramps over a quarter of the overlap of the two zones while the overlap is at
+    /// least a tenth of the new zone. Below that, the ramp covers the whole overlap (from the
+    /// new end to the remembered one), provided at least `FADE_POINTS` of the new zone's
+    /// collocation points fall within it; otherwise the earlier zone is passed over and its
+    /// kink is left to the series.
+    ///
+    /// Why: where a remembered end lies within a tenth of the zone of the new one (the
+    /// insulating Figure-3 history at η = 0.2, steps 57–60), leaving its kink to the series
+    /// makes those steps' stick ends and dissipations several times less accurate than the
+    /// rest of the history; the ramp brings them back in line.
+    pub fn inheritance_for(
+        self: &std::sync::Arc<Self>,
+        lo: f64,
+        hi: f64,
+        nodes: usize,
+    ) -> Option<std::sync::Arc<Inherited>> {
+        let slack = 1e-12 * (hi - lo);
+        let inside = |x: f64| x > lo + slack && x < hi - slack;
+        // Collocation points of the new zone within `length` of one of its ends (about: the
+        // points are `cos((2r − 1)π/(2(M + 1)))` in the zone's variable).
+        let points_within = |length: f64| {
+            (nodes + 1) as f64 * (1.0 - 2.0 * length / (hi - lo)).clamp(-1.0, 1.0).acos()
+                / std::f64::consts::PI
+        };
+        let mut zone = Some(self.clone());
+        while let Some(z) = zone {
+            let overlap = z.hi.min(hi) - z.lo.max(lo);
+            let wide = overlap >= 0.1 * (hi - lo);
+            let short = !wide && points_within(overlap) >= FADE_POINTS;
+            let ramp = if wide { 0.25 * overlap } else { overlap };
+            let candidate = if z.lo >= lo - slack && z.hi <= hi + slack {
+                Some(Inherited::new(z.clone(), None, None))
+            } else if (wide || short) && (inside(z.lo) != inside(z.hi)) {
+                let ramp_lo = (!inside(z.lo)).then_some((lo, lo + ramp));
+                let ramp_hi = (!inside(z.hi)).then_some((hi - ramp, hi));
+                Some(Inherited::new(z.clone(), ramp_lo, ramp_hi))
+            } else if z.kink.abs() > 0.0 && inside(z.mid()) && overlap >= 0.1 * (hi - lo) {
+                Some(Inherited::new(
+                    z.clone(),
+                    Some((lo, lo + ramp)),
+                    Some((hi - ramp, hi)),
+                ))
+            } else {
+                None
+            };
+            if let Some(mut c) = candidate {
+                // A zone that carries nothing of its own and inherits an earlier zone whole
+                // has exactly that zone's q̃ (a return to a remembered state, once per cycle):
+                // carry the earlier zone instead, so that chains do not grow with the cycles.
+                while let Some(inner) = c
+                    .zone
+                    .inherited
+                    .as_ref()
+                    .filter(|i| c.zone.carries_nothing() && !i.faded())
+                {
+                    c.zone = inner.zone.clone();
+                }
+                return Some(std::sync::Arc::new(c));
+            }
+            zone = z.inherited.as_ref().map(|i| i.zone.clone());
+        }
+        None
+    }
+
+    /// The most terms of a series in the zone or its chain (M).
+    fn series_terms(&self) -> usize {
+        std::iter::once(self)
+            .chain(self.links().map(|l| l.zone.as_ref()))
+            .map(|z| z.correction.beta.len())
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Number of zones in the chain.
+    pub fn chain_len(&self) -> usize {
+        1 + self.links().count()
+    }
+
+    /// The inherited corrections of the chain, outermost first.
+    pub fn links(&self) -> impl Iterator<Item = &Inherited> {
+        std::iter::successors(self.inherited.as_deref(), |i| i.zone.inherited.as_deref())
+    }
+
+    /// Where q̃ may fail to be smooth besides the zone's ends: the ends of the zones in its
+    /// chain (square roots), their fade ramps, and centre kinks (see [`kink_density`]); not
+    /// filtered to the zone.
+    pub(super) fn chain_points(&self) -> Vec<f64> {
+        let mut points: Vec<f64> = self.kink_point().into_iter().collect();
+        for i in self.links() {
+            points.extend([i.zone.lo, i.zone.hi]);
+            points.extend(i.zone.kink_point());
+            points.extend(i.ramp_points());
+        }
+        points
+    }
+
+    /// The zone's centre when it carries a centre kink (see [`kink_density`]).
+    fn kink_point(&self) -> Option<f64> {
+        (self.kink.abs() > 0.0).then_some(self.mid())
+    }
+}
+
+impl StickZone {
+    /// Centre of the zone (m).
+    pub fn mid(&self) -> f64 {
+        0.5 * (self.lo + self.hi)
+    }
+    /// Half-width (m).
+    pub fn half(&self) -> f64 {
+        0.5 * (self.hi - self.lo)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{faded_chain, worst_relative};
+    use super::*;
+
+    #[test]
+    fn tabulated_cauchy_transform_matches_the_direct_one() {
+        // A normal-loading-like zone (centre kink) faded into a narrower zone with a series of
+        // its own, as in the first tangential phase; the table against the series and chain,
+        // inside, next to every breakpoint, outside within the table and beyond it.
+        let zone = faded_chain(64, Some(96), Vec::new());
+        let direct = zone.clone();
+        zone.tabulate(96);
+        let mut points: Vec<f64> = (0..=2000).map(|i| -2.1 + 3.7 * i as f64 / 2000.0).collect();
+        for b in [-2.0, -0.8, -0.55, 0.0, 0.1, 0.4, 1.6] {
+            points.extend([b - 1e-9, b - 1e-4, b + 1e-4, b + 1e-9]);
+        }
+        let worst = worst_relative(
+            &points,
+            |x| zone.correction_cauchy(x),
+            |x| direct.correction_cauchy(x),
+        );
+        // Measured 3.6e−12 (1e−9 outside the zone's left end, where the exterior transform
+        // has its square root); the bound is 1e−11.
+        assert!(worst < 1e-11, "worst relative difference {worst:e}");
+        // The batched lookup (four points of a piece at a time, direct beyond the table) is
+        // the one-point lookup bit for bit.
+        let mut batch = Vec::new();
+        zone.correction_cauchys_into(&points, &mut batch);
+        for (v, &x) in batch.iter().zip(&points) {
+            assert_eq!(v.to_bits(), zone.correction_cauchy(x).to_bits(), "at {x}");
+        }
+    }
+
+    /// A zone without `tabulate`'s table (a step's accepted zone: a series of its own, the
+    /// normal-loading-like zone faded into it, a half-ellipse extra) tabulates its transform on
+    /// the outer pieces at a batch with enough points there, not before; the tables against
+    /// the series and chain on both pieces, next to the stick ends (where the transform has
+    /// its square root) and beyond the tables (direct); the one-point form is the batch's to
+    /// the bit before and after.
+    #[test]
+    fn exterior_tables_match_the_direct_transform() {
+        let zone = faded_chain(128, Some(160), vec![(-0.55, 0.4, 0.2)]);
+        let direct = zone.clone();
+        let (w, mut out) = (zone.hi - zone.lo, Vec::new());
+        let few: Vec<f64> = (1..=20)
+            .map(|i| zone.hi + 0.01 * w * f64::from(i))
+            .collect();
+        zone.correction_cauchys_into(&few, &mut out);
+        assert!(
+            zone.exterior_table.0.get().is_none(),
+            "{} points",
+            few.len()
+        );
+        // Both outer pieces, graded towards the stick ends, and points beyond the tables.
+        let mut points: Vec<f64> = Vec::new();
+        for i in 1..=400 {
+            let r = w * (f64::from(i) / 400.0).powi(3);
+            points.extend([zone.lo - r, zone.hi + r]);
+        }
+        points.extend([zone.lo - 1.5 * w, zone.hi + 2.0 * w]);
+        let mut batch = Vec::new();
+        zone.correction_cauchys_into(&points, &mut batch);
+        assert!(zone.exterior_table.0.get().is_some());
+        let worst = worst_relative(
+            &points,
+            |x| zone.correction_cauchy(x),
+            |x| direct.correction_cauchy(x),
+        );
+        // Measured 5.7e−13, next to the stick ends (the closest points 2e−8 w from them; at
+        // 1e−12 w the direct sums themselves are off, by 5e−10 against the table's limit). On
+        // every accepted zone of the Figure-3 histories (η = 0.2, 0.3, insulating at 0.4) and
+        // the variable-amplitude history, M = 64 … 512, at 800 points from 1.6e−8 w to w on
+        // both sides: 2.5e−12, and 1.6e−11 for one variable-amplitude zone at M = 128. The
+        // bound is 1e−12.
+        assert!(worst < 1e-12, "worst relative difference {worst:e}");
+        for (v, &x) in batch.iter().zip(&points) {
+            assert_eq!(v.to_bits(), zone.correction_cauchy(x).to_bits(), "at {x}");
+        }
+    }
+
+    #[test]
+    fn tabulated_values_match_the_direct_ones() {
+        // The chain of the test above (a centre kink, `u ln|u|` at the base's centre, faded
+        // into a narrower zone, here with a half-ellipse extra), tabulated, against the same
+        // chain untabulated: inside, next to every breakpoint, and outside (zero). Only the
+        // zone with a link gets a value table.
+        let chain = |tabulated: bool| {
+            let zone = faded_chain(64, tabulated.then_some(96), vec![(-0.55, 0.4, 0.2)]);
+            if tabulated {
+                zone.tabulate(96);
+            }
+            zone
+        };
+        let (zone, direct) = (chain(true), chain(false));
+        let mut points: Vec<f64> = (0..=2000).map(|i| -1.1 + 2.2 * i as f64 / 2000.0).collect();
+        for b in [-0.95, -0.8, -0.55, 0.0, 0.1, 0.4, 0.95] {
+            points.extend([b - 1e-9, b - 1e-4, b, b + 1e-4, b + 1e-9]);
+        }
+        let worst = worst_relative(
+            &points,
+            |x| zone.correction_at(x),
+            |x| direct.correction_at(x),
+        );
+        // Measured 2.5e−12, next to the zone's left end (the series' 1/k² tail: 7.0e−12 with
+        // 128 terms and 160 nodes, 1.5e−11 with 256 and 288); 1e−8 at the centre kink before
+        // `chain_kinks` was taken out of the table. The bound is 1e−11.
+        assert!(worst < 1e-11, "worst relative difference {worst:e}");
+        for x in [-1.0, -0.8, 0.4, 0.5] {
+            assert_eq!(zone.correction_at(x).to_bits(), 0, "outside, at {x}");
+        }
+        let mut batch = Vec::new();
+        zone.corrections_into(&points, &mut batch);
+        for (v, &x) in batch.iter().zip(&points) {
+            assert_eq!(v.to_bits(), zone.correction_at(x).to_bits(), "at {x}");
+        }
+    }
+
+    #[test]
+    fn inherited_corrections_vanish_outside_the_new_zone() {
+        // `correction_at` returns zero outside its zone without walking the chain; that is
+        // exact only if every link `inheritance_for` builds is zero there: a link carried
+        // whole lies inside the new zone, a faded one has χ = 0 beyond the new zone's ends.
+        let series = BoundedSeries {
+            beta: (1..=16).map(|k| 1.0 / (k * k) as f64).collect(),
+        };
+        let old = std::sync::Arc::new(StickZone::new(-0.9, 0.9, series.clone(), -0.3));
+        let inner = std::sync::Arc::new(StickZone {
+            inherited: old.inheritance_for(-0.7, 0.5, 64),
+            ..StickZone::new(-0.7, 0.5, series, 0.0)
+        });
+        // New zones inside, across either end, and around the older zones.
+        let cases = [
+            (-0.6, 0.4),
+            (-0.8, 0.2),
+            (-0.2, 0.7),
+            (-0.95, 0.95),
+            (-0.5, 0.45),
+        ];
+        let mut links = 0;
+        for base in [&old, &inner] {
+            for (lo, hi) in cases {
+                let Some(link) = base.inheritance_for(lo, hi, 64) else {
+                    continue;
+                };
+                links += 1;
+                for i in 0..=400 {
+                    let x = -1.2 + 2.4 * i as f64 / 400.0;
+                    if x > lo && x < hi {
+                        continue;
+                    }
+                    let outside_link = !(x > link.zone.lo && x < link.zone.hi);
+                    assert!(
+                        outside_link || link.chi(x).abs() <= 0.0,
+                        "zone [{lo}, {hi}], link [{}, {}]: χ({x}) = {}",
+                        link.zone.lo,
+                        link.zone.hi,
+                        link.chi(x)
+                    );
+                }
+            }
+        }
+        assert!(links >= 8, "{links} links built");
+    }
+}

@@ -1,0 +1,440 @@
+//! One load step: the driver state that outlives a step ([`DriverState`]), and the step itself,
+//! solved by [`solve_slip`] from the committed state and memory, checked, and only then
+//! committed ([`solve_step`], then [`finish_step`] with the step's increments and record;
+//! [`advance`] does both). A new phase stores the memory of the current state.
+
+use std::sync::{Arc, OnceLock};
+
+use crate::contact::memory::Memory;
+use crate::contact::normal::NormalLoading;
+use crate::contact::pressure::Discretisation;
+use crate::contact::tangential::{
+    PhaseStart, Recalled, SlipOptions, SlipStep, StepAdmissibility, WarmStart, solve_slip,
+};
+use crate::contact::{ContactModel, ContactState};
+
+use super::hints::{
+    HISTORY_POINTS, TraceStep, TracedIncrements, Traces, footprint, load_and_geometry,
+    phase_start_guess, predict,
+};
+use super::increments::{IncrementInputs, StepIncrements};
+use super::load::LoadPoint;
+use super::record::{Observer, StepFailure, StepRecord};
+use super::regime::{Regime, next_regime};
+
+/// Driver state that outlives a step.
+#[derive(Debug, Clone)]
+pub struct DriverState {
+    /// Committed contact state.
+    pub state: ContactState,
+    /// Memory of the current phase.
+    pub memory: Memory,
+    /// Slip sign of the current phase (`None` before the first slip).
+    pub phase_sign: Option<f64>,
+    /// Phase number.
+    pub phase: usize,
+    /// `[Q, lo, hi, a, c]` of the last steps of the phase (at most [`HISTORY_POINTS`]), for the
+    /// predictor of the next step.
+    history: Vec<[f64; 5]>,
+    /// Stick zone (with its correction chain) of the state that began the phase.
+    base: Option<Arc<crate::contact::StickZone>>,
+    /// Tangential load at the start of the phase (N/m).
+    phase_start_load: f64,
+    /// Accumulated punch displacement δ (m).
+    pub displacement: f64,
+    /// The material point at which δ is followed while it sticks (m).
+    anchor: f64,
+    /// `ux` of the committed state at the anchor, once computed: `(anchor, ux)` (m).
+    pub(super) anchor_ux: Option<(f64, f64)>,
+    /// Normal approach δn of the current state (m), once computed.
+    pub(super) approach: Option<f64>,
+    /// Slip signs and Jacobian of the last step, the warm start of the next step of a phase.
+    warm: Option<WarmStart>,
+    /// `dc/dQ` over the first step of the current phase: the start of the next phase's
+    /// prediction of the contact centre.
+    first_centre_slope: Option<f64>,
+    /// The steps of the current phase, and of the last finished phase of each direction
+    /// (reverse, forward): a later phase that begins from the same turning state recalls them.
+    traces: Traces,
+    /// How the last phase that began with mixed slip signs began ([`PhaseStart`]).
+    last_start: Option<PhaseStart>,
+}
+
+impl DriverState {
+    /// Start from the end of normal loading.
+    pub fn after_normal_loading(normal: &NormalLoading) -> Self {
+        let state = normal.state.clone();
+        let b = normal.stick_half_width;
+        let memory =
+            Memory::after_normal_loading(Arc::new(state.clone()), normal.strain_slope, -b, b);
+        let base = normal.state.traction.stick.clone().map(Arc::new);
+        Self {
+            state,
+            memory,
+            phase_sign: None,
+            phase: 0,
+            history: Vec::new(),
+            base,
+            phase_start_load: 0.0,
+            displacement: 0.0,
+            anchor: normal
+                .state
+                .traction
+                .stick
+                .as_ref()
+                .map_or(0.0, |z| z.mid()),
+            anchor_ux: None,
+            approach: None,
+            warm: None,
+            first_centre_slope: None,
+            traces: Traces::default(),
+            last_start: None,
+        }
+    }
+}
+
+/// Advance the driver by one load step: solve it ([`solve_step`]), compute its increments
+/// ([`StepIncrements::compute`]) and commit them ([`finish_step`]).
+pub fn advance(
+    model: &ContactModel,
+    disc: &Discretisation,
+    driver: &mut DriverState,
+    point: LoadPoint,
+    options: SlipOptions,
+    observer: &mut dyn Observer,
+) -> Result<StepRecord, StepFailure> {
+    Ok(match solve_step(model, disc, driver, point, options)? {
+        Solved::Hold(regime) => hold_record(driver, point, regime, observer),
+        Solved::Slip(solved) => {
+            let increments = solved.known_increments().unwrap_or_else(|| {
+                StepIncrements::compute(model, &solved.increment_inputs(driver))
+            });
+            finish_step(driver, *solved, increments, observer)
+        }
+    })
+}
+
+/// A solved step: a hold (nothing changes) or a slip step whose increments are still to be
+/// computed.
+pub enum Solved {
+    /// ΔQ = 0 (the regime is [`Regime::Stick`]).
+    Hold(Regime),
+    /// A slip step, committed to the driver except for its increments.
+    Slip(Box<SolvedStep>),
+}
+
+/// A slip step whose state is committed to the driver and whose increments (δ, dissipation,
+/// works) are still to be computed; they need only the two states and the anchor, so they
+/// can be computed while the next step is solved.
+pub struct SolvedStep {
+    /// The step's record without the increments.
+    record: StepRecord,
+    /// The states and the anchor; what the previous step knows of the old state is filled in
+    /// by [`SolvedStep::increment_inputs`].
+    pub(super) inputs: IncrementInputs,
+    /// The phase this step begins, with its memory (for the observer).
+    new_phase: Option<(usize, Memory)>,
+    /// The increments, when the step reproduced a recalled step whose increments are known.
+    pub(super) known: Option<StepIncrements>,
+    /// Where the step's increments are kept for a later phase that recalls it.
+    trace: Option<Arc<OnceLock<(f64, StepIncrements)>>>,
+}
+
+/// The record of a hold step (nothing changes), passed to the observer.
+pub(super) fn hold_record(
+    driver: &DriverState,
+    point: LoadPoint,
+    regime: Regime,
+    observer: &mut dyn Observer,
+) -> StepRecord {
+    let mut rec = record(point.step, point.t, driver, regime, None);
+    rec.q = point.q;
+    observer.on_step(&rec, &driver.state);
+    rec
+}
+
+/// Commit a solved step's increments to the driver (δ, the anchor's ux, δn) and pass its
+/// record to the observer (after the phase it begins, if any). Steps must be finished in
+/// order.
+pub fn finish_step(
+    driver: &mut DriverState,
+    solved: SolvedStep,
+    increments: StepIncrements,
+    observer: &mut dyn Observer,
+) -> StepRecord {
+    if let Some(cell) = &solved.trace {
+        // Set once: a step is finished once.
+        let _ = cell.set((solved.inputs.anchor, increments));
+    }
+    driver.anchor_ux = Some((solved.inputs.anchor, increments.new_ux));
+    driver.approach = Some(increments.new_approach);
+    driver.displacement += increments.displacement;
+    let mut rec = solved.record;
+    rec.displacement = driver.displacement;
+    rec.dissipation = increments.dissipation;
+    rec.normal_work = increments.normal_work;
+    rec.electric_work = increments.electric_work;
+    if let Some((phase, memory)) = &solved.new_phase {
+        observer.on_phase(*phase, memory);
+    }
+    observer.on_step(&rec, &solved.inputs.new);
+    rec
+}
+
+/// Solve one load step and commit its state to the driver (phase, memory, anchor, warm
+/// start); its increments are left to [`finish_step`].
+pub fn solve_step(
+    model: &ContactModel,
+    disc: &Discretisation,
+    driver: &mut DriverState,
+    point: LoadPoint,
+    options: SlipOptions,
+) -> Result<Solved, StepFailure> {
+    let LoadPoint { step, t, q } = point;
+    let dq = q - driver.state.tangential_load;
+    let limit = model.friction * driver.state.normal_load;
+    let regime = next_regime(dq, 1e-12 * limit);
+    let Some(sign) = regime.slip_sign() else {
+        return Ok(Solved::Hold(regime));
+    };
+    let new_phase = driver.phase_sign != Some(sign);
+    let predicted = (!new_phase).then(|| predict(&driver.history, q)).flatten();
+    let guess = if new_phase {
+        phase_start_guess(model, &driver.state, sign, dq)
+    } else {
+        match predicted {
+            Some([lo, hi, ..]) => (lo, hi),
+            None => phase_start_guess(model, &driver.state, sign, dq),
+        }
+    };
+    if new_phase && let Some(zone) = driver.state.traction.stick.as_ref() {
+        // The turning state is about to be cloned into the memory and into the new phase's
+        // base, and both are evaluated at every residual evaluation of the phase: tabulate its
+        // H'q̃ and q̃ first, so that the clones share one table (`StickZone::tabulate`; the
+        // normal-loading state comes tabulated, and earlier bases in the chain were tabulated
+        // when their phases began). A zone accepted in the middle of a phase is evaluated only
+        // by the next step's checks and increments, too few times to pay for a table (default
+        // run: tabulating every accepted zone 1.81 s, the bases only 1.60 s, δ and the stick
+        // ends the same to 1e−13 of themselves).
+        zone.tabulate(disc.nodes() + 32);
+    }
+    let memory = if new_phase {
+        match (&driver.phase_sign, driver.state.traction.stick.as_ref()) {
+            (None, _) => driver.memory.clone(),
+            (Some(_), Some(s)) => {
+                driver
+                    .memory
+                    .committed(Arc::new(driver.state.clone()), s.lo, s.hi)
+            }
+            (Some(_), None) => driver.memory.clone(),
+        }
+    } else {
+        driver.memory.clone()
+    };
+    let base = if new_phase {
+        driver.state.traction.stick.clone().map(Arc::new)
+    } else {
+        driver.base.clone()
+    };
+    // Second guess: the Mindlin–Deresiewicz size for the load change since the phase began,
+    // centred on the contact.
+    let start_load = if new_phase {
+        driver.state.tangential_load
+    } else {
+        driver.phase_start_load
+    };
+    let (c, a) = (driver.state.centre, driver.state.half_width);
+    let md = (1.0 - ((q - start_load).abs() / (2.0 * limit)).min(0.95)).sqrt();
+    let md_guess = (c - a * md, c + a * md);
+    // After a step with mixed slip signs (the first steps after a reversal, one edge still
+    // slipping the old way) the previous stick ends do not continue the standard state: its
+    // edge zone closes and that stick end jumps. The continuation then converges to a state
+    // that fails the stick check (about 20 wasted evaluations at each such step), so the
+    // Mindlin–Deresiewicz guess goes first; the states are the same either way.
+    let after_mixed = driver.warm.is_some_and(|w| w.signs != (sign, sign));
+    let guesses = if after_mixed {
+        [md_guess, guess]
+    } else {
+        [guess, md_guess]
+    };
+    // The contact's half-width and centre to start from: extrapolated within a phase. At a
+    // phase start the centre is moved by dc/dQ of the previous phase's first step times ΔQ,
+    // and the half-width, which changes little, is kept. (The first step of a reversal moves
+    // the centre by about as much as the first loading step did; started from the old centre,
+    // the mixed-sign attempt of a reversal step spends about ten quasi-Newton iterations
+    // getting there. The states are the same either way.)
+    let contact = if new_phase {
+        driver.first_centre_slope.map(|slope| (a, c + slope * dq))
+    } else {
+        predicted.map(|[.., a, c]| (a, c))
+    };
+    // The same step of the last phase in this direction that began from the same turning
+    // state: in a steady cycle it solves this step again.
+    let phase_start = if new_phase {
+        Some(load_and_geometry(&driver.state))
+    } else {
+        driver.traces.current.as_ref().map(|t| t.start)
+    };
+    let traced = phase_start
+        .filter(|_| options.recall)
+        .and_then(|start| driver.traces.recall(&start, sign, q, limit))
+        .cloned();
+    // The recalled step's checks go with it when this step begins from its start.
+    let from = footprint(&driver.state);
+    let recalled = traced.as_ref().map(|t| Recalled {
+        admissibility: t
+            .recalled
+            .admissibility
+            .filter(|_| t.increments.began_from(from)),
+        ..t.recalled.clone()
+    });
+    let solved: SlipStep = solve_slip(
+        model,
+        disc,
+        &memory,
+        base.as_ref(),
+        &driver.state,
+        q,
+        sign,
+        &guesses,
+        contact,
+        if new_phase {
+            None
+        } else {
+            driver.warm.as_ref()
+        },
+        recalled.as_ref(),
+        driver.last_start.as_ref().filter(|_| new_phase),
+        options,
+    )
+    .map_err(|failure| StepFailure {
+        step,
+        t,
+        q,
+        regime,
+        failure,
+    })?;
+    if new_phase {
+        if let Some(start) = PhaseStart::of(&solved.state, sign) {
+            driver.last_start = Some(start);
+        }
+        driver.first_centre_slope = Some((solved.state.centre - c) / dq);
+        driver.phase += 1;
+        driver.phase_start_load = start_load;
+        driver.phase_sign = Some(sign);
+        driver.memory = memory;
+        driver.base = base;
+        driver.history.clear();
+    }
+    // Keep the anchor of δ while it sticks; otherwise take the middle of the part of the old
+    // stick zone that still sticks.
+    let new_zone = solved.state.traction.stick.as_ref().expect("slip state");
+    let margin = 1e-3 * (new_zone.hi - new_zone.lo);
+    if !(driver.anchor > new_zone.lo + margin && driver.anchor < new_zone.hi - margin) {
+        let (lo, hi) = driver
+            .state
+            .traction
+            .stick
+            .as_ref()
+            .map_or((new_zone.lo, new_zone.hi), |z| {
+                (z.lo.max(new_zone.lo), z.hi.min(new_zone.hi))
+            });
+        driver.anchor = if hi > lo {
+            0.5 * (lo + hi)
+        } else {
+            new_zone.mid()
+        };
+    }
+    driver.warm = Some(WarmStart {
+        signs: (
+            solved.state.traction.left_sign,
+            solved.state.traction.right_sign,
+        ),
+        jacobian: solved.jacobian,
+    });
+    // A step that repeated the recalled one, with the same anchor, has its increments
+    // (module docs, "Recall of a repeated phase").
+    let known = traced
+        .filter(|_| solved.repeated)
+        .and_then(|t| t.increments.for_repeat(driver.anchor));
+    let old = std::mem::replace(&mut driver.state, solved.state.clone());
+    driver.history.push(load_and_geometry(&driver.state));
+    if driver.history.len() > HISTORY_POINTS {
+        driver.history.remove(0);
+    }
+    let record = record(step, t, driver, regime, Some(&solved));
+    let new = Arc::new(solved.state);
+    // A step accepted at a stalled residual is not recalled: the next cycle's step tries to
+    // converge (default history at M = 64 with 20 steps per segment: the step at −0.075 ηP
+    // stalled at 1.4e−6 in the second cycle and converged from its own path in the third).
+    let converged = solved.residual < options.tolerance;
+    let increments = Arc::new(OnceLock::new());
+    let trace = converged.then(|| TraceStep {
+        q,
+        recalled: Recalled {
+            state: Arc::clone(&new),
+            warm: driver.warm.expect("set above"),
+            admissibility: Some(solved.admissibility),
+        },
+        increments: TracedIncrements {
+            from,
+            value: Arc::clone(&increments),
+        },
+    });
+    driver
+        .traces
+        .push(phase_start.filter(|_| new_phase), sign, trace);
+    Ok(Solved::Slip(Box::new(SolvedStep {
+        record,
+        inputs: IncrementInputs {
+            old: Arc::new(old),
+            new,
+            anchor: driver.anchor,
+            old_ux: None,
+            old_approach: None,
+        },
+        new_phase: new_phase.then(|| (driver.phase, driver.memory.clone())),
+        known,
+        trace: converged.then_some(increments),
+    })))
+}
+
+/// The record of the driver's committed state, with zero increments (a hold's; a slip step's
+/// are filled in by [`finish_step`]).
+pub(super) fn record(
+    step: usize,
+    t: f64,
+    driver: &DriverState,
+    regime: Regime,
+    solved: Option<&SlipStep>,
+) -> StepRecord {
+    let s = &driver.state;
+    let (lo, hi) = s
+        .traction
+        .stick
+        .as_ref()
+        .map_or((s.centre - s.half_width, s.centre + s.half_width), |z| {
+            (z.lo, z.hi)
+        });
+    StepRecord {
+        step,
+        t,
+        q: s.tangential_load,
+        regime,
+        phase: driver.phase,
+        half_width: s.half_width,
+        eccentricity: -s.centre,
+        stick_lo: lo,
+        stick_hi: hi,
+        left_slip_sign: s.traction.left_sign,
+        right_slip_sign: s.traction.right_sign,
+        iterations: solved.map_or(0, |x| x.iterations),
+        newton_iterations: solved.map_or(0, |x| x.newton_iterations),
+        residual: solved.map_or(0.0, |x| x.residual),
+        admissibility: solved.map_or_else(StepAdmissibility::default, |x| x.admissibility),
+        displacement: driver.displacement,
+        dissipation: 0.0,
+        normal_work: 0.0,
+        electric_work: 0.0,
+    }
+}

@@ -1,0 +1,88 @@
+//! The load-history driver: a piecewise-linear tangential load Q(t) walked step by step through
+//! a closed set of solver states, with the strain memory stored at the start of every monotonic
+//! phase (seed Section 4; `docs/formulation.md` §4).
+//!
+//! # States and transitions
+//! [`Regime`] is closed: normal loading, stick (hold), forward slip, reverse slip. The next
+//! regime is a pure function of the sign of ΔQ ([`next_regime`]): `ΔQ > 0` forward slip,
+//! `ΔQ < 0` reverse slip, `ΔQ = 0` stick (nothing changes, the state is carried over). A phase
+//! begins whenever the slip direction differs from the previous slip phase's (or at the first
+//! slip step after normal loading): then the memory is recomputed from the current state over
+//! the whole contact ([`Memory::committed`]). A hold between two segments of the same
+//! direction does not start a new phase.
+//!
+//! # Steps
+//! Each segment `(t0, Q0) → (t1, Q1)` is cut into `max(steps_per_segment, ⌈|ΔQ|/max_step⌉)`
+//! equal steps. Each step is solved by [`solve_slip`] from the committed state and memory,
+//! checked, and only then committed (trial, then commit). A failure stops the run with the
+//! step, t, Q and regime; the steps already solved are kept by the caller (observer).
+//!
+//! A step's increments — Δδ at the anchor, the frictional dissipation and the works of P and
+//! of the electric load ([`StepIncrements`], [`step_dissipation`]) — need only the step's two
+//! states, and the next step needs none of them, so [`run_history`] computes them on a second
+//! thread while it solves the next step ([`solve_step`], then [`finish_step`] in order);
+//! [`continue_run`] does the same from any driver state, and [`advance`] does it
+//! sequentially. The records are the same either way.
+//!
+//! # Warm start
+//! Inside a phase the geometry of the step (stick ends, contact half-width and centre) is
+//! extrapolated from the last three steps by the quadratic in Q through them (`predict`), and
+//! the previous step's Jacobian starts the quasi-Newton iteration (after a step with mixed
+//! slip signs the Mindlin–Deresiewicz guess below is tried first). At the
+//! start of a phase the zones that already slip in the new direction keep slipping and the
+//! others stick, with new slip zones of the Mindlin–Deresiewicz width
+//! `a(1 − √(1 − |ΔQ|/(2ηP)))` at the ends that start to slip, and the contact centre moves by
+//! ΔQ times dc/dQ of the previous phase's first step.
+//!
+//! # Recall of a repeated phase
+//! The driver keeps the accepted steps of the current phase and of the last finished phase of
+//! each direction (`Traces`). When a phase begins from the same turning state as the last
+//! phase of its direction (the load to 1e−9 of ηP, stick ends, a and c to 1e−8 a), each of
+//! its steps is started from that phase's step at the same load ([`Recalled`]). In a steady
+//! cycle that step solves the new one to the tolerance in one residual evaluation. Otherwise
+//! its residual exceeds the recall limit, and the step is solved as above
+//! (`SlipOptions::recall`).
+//!
+//! A step's checks, φ0 and increments are functions of its two states (and the anchor, for
+//! δ). When a step begins from a state whose geometry and slip signs are to the bit those of
+//! the state the recalled step began from, and is accepted at the recalled geometry (its first
+//! evaluation solved it), its two states are the recalled step's to the solver's tolerance:
+//! it takes that step's checks and φ0 ([`Recalled::admissibility`]) and, when δ is followed
+//! at the same anchor, its increments ([`SolvedStep::known_increments`]) instead of
+//! evaluating them (test
+//! `repeated_steps_take_the_checks_and_increments_they_would_compute`). In a steady cycle
+//! every step does: the step is one residual evaluation.
+//!
+//! [`Memory::committed`]: crate::contact::memory::Memory::committed
+//! [`solve_slip`]: crate::contact::tangential::solve_slip
+//! [`Recalled`]: crate::contact::tangential::Recalled
+//! [`Recalled::admissibility`]: crate::contact::tangential::Recalled::admissibility
+
+mod driver;
+mod hints;
+mod increments;
+mod load;
+mod record;
+mod regime;
+mod run;
+
+pub use driver::{DriverState, Solved, SolvedStep, advance, finish_step, solve_step};
+pub use increments::{IncrementInputs, StepIncrements, step_dissipation};
+pub use load::{LoadHistory, LoadPoint};
+pub use record::{NoObserver, Observer, StepFailure, StepRecord};
+pub use regime::{Regime, next_regime};
+pub use run::{HistoryFailure, HistoryRun, continue_run, run_history};
+
+#[cfg(test)]
+use crate::contact::pressure::Discretisation;
+
+/// The driver at the end of the normal loading of scenario `sc` on `disc` (tests' start).
+#[cfg(test)]
+pub(crate) fn driver_after_normal_loading(
+    sc: &crate::scenario::Scenario,
+    disc: &Discretisation,
+) -> DriverState {
+    use crate::contact::normal::{NormalOptions, solve_normal};
+    let normal = solve_normal(&sc.model, disc, sc.normal_load, NormalOptions::default()).unwrap();
+    DriverState::after_normal_loading(&normal)
+}

@@ -1,0 +1,95 @@
+//! What a step reports: its record ([`StepRecord`]), the observer that receives the records and
+//! each phase's memory ([`Observer`], [`NoObserver`]), and a failed step with its context
+//! ([`StepFailure`]).
+
+use serde::Serialize;
+
+use crate::contact::ContactState;
+use crate::contact::memory::Memory;
+use crate::contact::tangential::StepAdmissibility;
+use crate::error::SolveFailure;
+
+use super::regime::Regime;
+
+/// One recorded step.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StepRecord {
+    /// Step number (0 = end of normal loading).
+    pub step: usize,
+    /// Time (s).
+    pub t: f64,
+    /// Tangential load Q (N/m).
+    pub q: f64,
+    /// Regime.
+    pub regime: Regime,
+    /// Phase number (0 = normal loading; increments at each reversal).
+    pub phase: usize,
+    /// Contact half-width a (m).
+    pub half_width: f64,
+    /// Eccentricity e = −c (m).
+    pub eccentricity: f64,
+    /// Stick-zone left end (m).
+    pub stick_lo: f64,
+    /// Stick-zone right end (m).
+    pub stick_hi: f64,
+    /// `q/(ηp)` in the left slip zone (±1; 0 before any slip).
+    pub left_slip_sign: f64,
+    /// `q/(ηp)` in the right slip zone.
+    pub right_slip_sign: f64,
+    /// (Quasi-)Newton iterations on the step's geometry (stick ends, a, c) in the accepted
+    /// attempt (`newton_iterations` in `steps.csv`).
+    pub iterations: usize,
+    /// Residual evaluations of the accepted attempt, each a coupled linear solve at fixed
+    /// geometry, including those of finite-difference Jacobians (`evaluations` in `steps.csv`).
+    pub newton_iterations: usize,
+    /// Final relative change of the block iteration.
+    pub residual: f64,
+    /// Checks.
+    pub admissibility: StepAdmissibility,
+    /// Tangential displacement δ of the punch relative to the half-plane's datum (m), zero at
+    /// the end of normal loading.
+    pub displacement: f64,
+    /// Energy dissipated by friction in this step (J/m), `−∫ q Δs dx` with the mid-step q.
+    pub dissipation: f64,
+    /// Work of the normal load in this step, `P Δδn` (J/m).
+    pub normal_work: f64,
+    /// Work of the electric load in this step, `φ̄0 ΔΓ` (J/m; zero under charge control).
+    pub electric_work: f64,
+}
+
+/// Receives the accepted steps (progress bars, writers, test recorders).
+pub trait Observer {
+    /// Called once per accepted step with the committed state.
+    fn on_step(&mut self, _record: &StepRecord, _state: &ContactState) {}
+    /// Called when a new phase begins, with the memory that the phase will keep.
+    fn on_phase(&mut self, _phase: usize, _memory: &Memory) {}
+}
+
+/// An observer that does nothing.
+pub struct NoObserver;
+impl Observer for NoObserver {}
+
+/// A failed step, with its context.
+#[derive(Debug, Clone)]
+pub struct StepFailure {
+    /// Step number.
+    pub step: usize,
+    /// Time.
+    pub t: f64,
+    /// Q.
+    pub q: f64,
+    /// Regime attempted.
+    pub regime: Regime,
+    /// The failure.
+    pub failure: SolveFailure,
+}
+
+impl std::fmt::Display for StepFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "step {} (t = {} s, Q = {} N/m, {})",
+            self.step, self.t, self.q, self.regime
+        )
+    }
+}
