@@ -197,7 +197,12 @@ fn read_manifest(dir: &Path) -> Option<Manifest> {
 /// why the folder is not a fretsim folder of `kind`.
 fn foreign_entry(dir: &Path, kind: FolderKind) -> Result<Option<String>, String> {
     let all = entries(dir).map_err(|e| format!("it cannot be read ({e})"))?;
-    if all.is_empty() {
+    // A sweep folder that another shard is creating holds only fretsim's hidden files until
+    // its manifest is in place: it counts as empty.
+    if all
+        .iter()
+        .all(|e| kind == FolderKind::Sweep && hidden_ours(e))
+    {
         return Ok(None);
     }
     let Some(manifest) = read_manifest(dir) else {
@@ -227,12 +232,11 @@ fn foreign_entry(dir: &Path, kind: FolderKind) -> Result<Option<String>, String>
     Ok(all.into_iter().find(|e| !known(e)))
 }
 
-/// The names a sweep folder may hold: its manifest, index, CSV files, comparison plots, the
-/// variants' folders (each checked as a run folder when it is written) and fretsim's hidden
-/// staging, lock and temporary files.
-fn sweep_entry(e: &str) -> bool {
+/// Whether the top-level name of entry `e` is one of fretsim's hidden lock, staging or
+/// temporary files.
+fn hidden_ours(e: &str) -> bool {
     let top = e.split('/').next().unwrap_or(e);
-    let hidden_ours = top.starts_with('.')
+    top.starts_with('.')
         && [
             ".fretsim-lock",
             ".fretsim-new",
@@ -240,8 +244,15 @@ fn sweep_entry(e: &str) -> bool {
             ".fretsim-tmp",
         ]
         .iter()
-        .any(|s| top.ends_with(s));
-    hidden_ours
+        .any(|s| top.ends_with(s))
+}
+
+/// The names a sweep folder may hold: its manifest, index, CSV files, comparison plots, the
+/// variants' folders (each checked as a run folder when it is written) and fretsim's hidden
+/// staging, lock and temporary files.
+fn sweep_entry(e: &str) -> bool {
+    let top = e.split('/').next().unwrap_or(e);
+    hidden_ours(e)
         || e == MANIFEST
         || e == "index.html"
         || e == "sweep.csv"
@@ -678,6 +689,23 @@ mod tests {
         let err = RunFolder::claim(&tmp.path().join("out"), &protected_none()).unwrap_err();
         assert!(err.to_string().contains("in the way"), "{err}");
         assert!(staging.join("mine.txt").exists());
+    }
+
+    /// Two shards start at once: the second finds the folder with only the first one's
+    /// temporary manifest in it, which is no reason to refuse it.
+    #[test]
+    fn a_sweep_folder_being_created_by_another_shard_is_accepted() {
+        let tmp = tempfile::tempdir().unwrap();
+        let target = tmp.path().join("sw");
+        fs::create_dir(&target).unwrap();
+        fs::write(target.join(".fretsim-manifest.json.1.fretsim-tmp"), "{").unwrap();
+        assert!(SweepFolder::claim(&target, "sweep-2-of-2.csv", &protected_none()).is_ok());
+        assert!(read_manifest(&target).is_some());
+        // A run folder is never shared: the same leftover inside it is not its own.
+        let run = tmp.path().join("run");
+        fs::create_dir(&run).unwrap();
+        fs::write(run.join(".x.fretsim-tmp"), "").unwrap();
+        assert!(RunFolder::claim(&run, &protected_none()).is_err());
     }
 
     #[test]
