@@ -20,7 +20,7 @@ use super::hints::{
 use super::increments::{IncrementInputs, StepIncrements};
 use super::load::LoadPoint;
 use super::record::{Observer, StepFailure, StepRecord};
-use super::regime::{Regime, next_regime};
+use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
 
 /// Driver state that outlives a step.
 #[derive(Debug, Clone)]
@@ -197,7 +197,7 @@ pub fn solve_step(
     let Some(sign) = regime.slip_sign() else {
         return Ok(Solved::Hold(regime));
     };
-    let new_phase = driver.phase_sign != Some(sign);
+    let new_phase = matches!(phase_event(driver.phase_sign, regime), PhaseEvent::Begin(_));
     let predicted = (!new_phase).then(|| predict(&driver.history, q)).flatten();
     let guess = if new_phase {
         phase_start_guess(model, &driver.state, sign, dq)

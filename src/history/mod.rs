@@ -70,7 +70,7 @@ pub use driver::{DriverState, Solved, SolvedStep, advance, finish_step, solve_st
 pub use increments::{IncrementInputs, StepIncrements, step_dissipation};
 pub use load::{LoadHistory, LoadPoint};
 pub use record::{NoObserver, Observer, StepFailure, StepRecord};
-pub use regime::{Regime, next_regime};
+pub use regime::{PhaseEvent, Regime, next_regime, phase_event};
 pub use run::{HistoryFailure, HistoryRun, continue_run, run_history};
 
 #[cfg(test)]
