@@ -375,6 +375,60 @@ pub(crate) struct VariantOutcome {
     normal: Option<NormalSummary>,
     error: Option<Error>,
     fields: Vec<FieldSet>,
+    /// The history's results (a sweep with runs, a scenario with a history).
+    history: Option<HistoryColumns>,
+}
+
+/// A variant's history in `sweep.csv` (sweeps with runs): steps, cycles, the verdict and the
+/// last full cycle's friction work and displacement amplitude.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct HistoryColumns {
+    steps: usize,
+    cycles: usize,
+    verdict: String,
+    friction_work: f64,
+    displacement_amplitude: f64,
+}
+
+impl HistoryColumns {
+    const HEADER: [&'static str; 5] = [
+        "steps",
+        "cycles",
+        "verdict",
+        "friction_work_last_cycle_J_per_m",
+        "delta_amplitude_last_cycle_m",
+    ];
+
+    fn of(summary: &crate::io::summary::Summary) -> Option<Self> {
+        let h = summary.history.as_ref()?;
+        let last = h.cycles.last();
+        let verdict = serde_json::to_value(&h.verdict)
+            .ok()
+            .and_then(|v| v.get("kind").and_then(|k| k.as_str()).map(String::from))
+            .unwrap_or_default();
+        Some(Self {
+            steps: h.steps,
+            cycles: h.cycles.len(),
+            verdict,
+            friction_work: last.map_or(f64::NAN, |c| c.friction_work),
+            displacement_amplitude: last.map_or(f64::NAN, |c| {
+                0.5 * (c.displacement_extremes.0 - c.displacement_extremes.1)
+            }),
+        })
+    }
+
+    fn cells(history: Option<&Self>) -> Vec<String> {
+        match history {
+            Some(h) => vec![
+                h.steps.to_string(),
+                h.cycles.to_string(),
+                h.verdict.clone(),
+                format!("{:.10e}", h.friction_work),
+                format!("{:.10e}", h.displacement_amplitude),
+            ],
+            None => vec![String::new(); Self::HEADER.len()],
+        }
+    }
 }
 
 /// Run every variant of `text` (a scenario) over the Cartesian product of `vary`, in
@@ -414,6 +468,7 @@ pub fn sweep(
                     // A history that stops part-way keeps its normal loading and the fields
                     // reached.
                     Ok(r) => VariantOutcome {
+                        history: HistoryColumns::of(&r.solution.summary),
                         normal: Some(r.solution.summary.normal_loading),
                         error: r.solution.failure,
                         fields: r.solution.fields,
@@ -422,6 +477,7 @@ pub fn sweep(
                         normal: None,
                         error: Some(e),
                         fields: Vec::new(),
+                        history: None,
                     },
                 }
             } else {
@@ -431,6 +487,7 @@ pub fn sweep(
                         normal: Some(normal_summary(&sc.model, &n)),
                         error: None,
                         fields: Vec::new(),
+                        history: None,
                     },
                     Err(failure) => VariantOutcome {
                         normal: None,
@@ -439,6 +496,7 @@ pub fn sweep(
                             failure,
                         }),
                         fields: Vec::new(),
+                        history: None,
                     },
                 }
             };
@@ -469,10 +527,13 @@ pub fn sweep(
             "charge_C_per_m",
             "potential_V",
             "slip_sign_right",
-            "error",
         ]
         .map(String::from),
     );
+    if options.runs {
+        header.extend(HistoryColumns::HEADER.map(String::from));
+    }
+    header.push("error".to_string());
     w.write_record(&header).expect("in-memory write");
     for ((i, values, _), o) in scenarios.iter().zip(&outcomes) {
         let mut row = vec![i.to_string()];
@@ -492,6 +553,9 @@ pub fn sweep(
                 .map(|x| format!("{x:.10e}")),
             ),
             None => row.extend(std::iter::repeat_n("NaN".to_string(), 7)),
+        }
+        if options.runs {
+            row.extend(HistoryColumns::cells(o.history.as_ref()));
         }
         row.push(o.error.as_ref().map(|e| e.to_string()).unwrap_or_default());
         w.write_record(&row).expect("in-memory write");

@@ -1140,3 +1140,48 @@ fn stalled_step_is_accepted_below_the_stall_tolerance_and_reported() {
         s.warnings
     );
 }
+
+/// `sweep --runs` reports each variant's history in `sweep.csv`: its steps and cycles, the
+/// verdict, and the last cycle's friction work and half range of δ, as its own `cycles.csv`
+/// and `summary.json` give them.
+#[test]
+fn sweep_with_runs_reports_each_variants_history() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("sw");
+    let o = fretsim()
+        .arg("sweep")
+        .arg(scenario_path("cattaneo_mindlin_uncoupled"))
+        .args(["--quiet", "--runs", "--vary", "friction=0.2:0.3:2", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    for (k, line) in lines.enumerate() {
+        let cells: Vec<&str> = line.split(',').collect();
+        let dir = out.join(format!("variant_{k:04}"));
+        let s = read_summary(&dir);
+        let h = s.history.as_ref().unwrap();
+        let (_, cycles) = read_csv(&dir.join("cycles.csv"));
+        let last = cycles.last().unwrap();
+        assert_eq!(cells[col("steps")].parse::<usize>().unwrap(), h.steps);
+        assert_eq!(cells[col("cycles")].parse::<usize>().unwrap(), cycles.len());
+        let verdict = match h.verdict {
+            Verdict::SteadyCyclicSlip { .. } => "steady_cyclic_slip",
+            Verdict::Shakedown { .. } => "shakedown",
+            Verdict::NotSettled { .. } => "not_settled",
+            Verdict::NoCycles => "no_cycles",
+        };
+        assert_eq!(cells[col("verdict")], verdict);
+        let work: f64 = cells[col("friction_work_last_cycle_J_per_m")]
+            .parse()
+            .unwrap();
+        assert!((work - last[7]).abs() <= 1e-9 * last[7].abs());
+        let amplitude: f64 = cells[col("delta_amplitude_last_cycle_m")].parse().unwrap();
+        assert!((amplitude - 0.5 * (last[10] - last[11])).abs() <= 1e-9 * amplitude.abs());
+        assert_eq!(*header.last().unwrap(), "error");
+    }
+}
