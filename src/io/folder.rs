@@ -351,10 +351,8 @@ impl RunFolder {
     /// Check that `target` may be written (see the module docs), lock it and create its
     /// staging folder. Nothing is solved yet and nothing of the user's is touched.
     pub fn claim(target: &Path, protected: &Protected) -> Result<Self, Error> {
-        let (parent, name) = resolve(target)?;
+        let (parent, name) = allowed(target, protected, FolderKind::Run)?;
         let canonical = parent.join(&name);
-        protected.check(target, &canonical)?;
-        check_target(target, &canonical, FolderKind::Run)?;
         let lock = Lock::take(parent.join(format!(".{name}.fretsim-lock")), target)?;
         let staging = parent.join(format!(".{name}.fretsim-new"));
         let old = parent.join(format!(".{name}.fretsim-old"));
@@ -377,10 +375,7 @@ impl RunFolder {
     /// Check, without claiming it, that `target` could be claimed now (a sweep checks its
     /// variants' folders before it solves any).
     pub fn check(target: &Path, protected: &Protected) -> Result<(), Error> {
-        let (parent, name) = resolve(target)?;
-        let canonical = parent.join(&name);
-        protected.check(target, &canonical)?;
-        check_target(target, &canonical, FolderKind::Run)
+        allowed(target, protected, FolderKind::Run).map(|_| ())
     }
 
     /// The folder the output will have once committed.
@@ -440,6 +435,20 @@ impl Drop for RunFolder {
     }
 }
 
+/// The target's canonical parent and name, once it is known to be neither protected nor
+/// anything but a fretsim folder of `kind` (or absent, or empty).
+fn allowed(
+    target: &Path,
+    protected: &Protected,
+    kind: FolderKind,
+) -> Result<(PathBuf, String), Error> {
+    let (parent, name) = resolve(target)?;
+    let canonical = parent.join(&name);
+    protected.check(target, &canonical)?;
+    check_target(target, &canonical, kind)?;
+    Ok((parent, name))
+}
+
 /// Refuse an existing target that is not a fretsim folder of `kind` (an empty folder is
 /// accepted: it holds nothing to lose).
 fn check_target(shown: &Path, canonical: &Path, kind: FolderKind) -> Result<(), Error> {
@@ -495,10 +504,8 @@ pub struct SweepFolder {
 impl SweepFolder {
     /// Check, create and lock the sweep folder `target` for the CSV file `csv_name`.
     pub fn claim(target: &Path, csv_name: &str, protected: &Protected) -> Result<Self, Error> {
-        let (parent, name) = resolve(target)?;
+        let (parent, name) = allowed(target, protected, FolderKind::Sweep)?;
         let canonical = parent.join(&name);
-        protected.check(target, &canonical)?;
-        check_target(target, &canonical, FolderKind::Sweep)?;
         if read_manifest(&canonical).is_none() {
             fs::create_dir_all(&canonical).map_err(write_err(target))?;
             let manifest = Manifest {

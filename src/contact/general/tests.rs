@@ -28,6 +28,16 @@ fn elastic(nu: f64, friction: f64, coupling: Coupling) -> ContactModel {
     .with_coupling(coupling)
 }
 
+/// PZT-4 under a cylinder of radius `radius` (m).
+fn pzt4(radius: f64, friction: f64, electrode: Electrode) -> ContactModel {
+    ContactModel::new(
+        Material::Piezoelectric(crate::material::PZT4),
+        Profile::cylinder(radius),
+        friction,
+        electrode,
+    )
+}
+
 /// Mesh of `[−1.1a, 1.1a]` symmetric about 0, size `end·a` at ±a, growing by 8 % per
 /// element up to `inner·a`.
 fn graded(a: f64, end: f64, inner: f64) -> Mesh {
@@ -284,12 +294,10 @@ fn spence_stick_ratio_goodman_and_full_coupling() {
 #[test]
 fn pzt4_conducting_punch_zhou_lee_and_baseline_stick_zone() {
     use crate::analytical::ZhouLee;
-    use crate::material::PZT4;
     let (p, gamma, radius) = (2000.0, 6e-7, 0.06);
     let model = |friction| {
-        ContactModel::new(
-            Material::Piezoelectric(PZT4),
-            Profile::cylinder(radius),
+        pzt4(
+            radius,
             friction,
             Electrode::ConductingCharge { charge: gamma },
         )
@@ -416,16 +424,10 @@ fn state_round_trips_through_json() {
 #[test]
 fn coupled_reversal_forms_old_direction_layers_at_the_ends() {
     use crate::analytical::ZhouLee;
-    use crate::material::PZT4;
     use ElementState::*;
     let (p, gamma, radius, eta) = (2000.0, 6e-7, 0.06, 0.1);
     let electrode = Electrode::ConductingCharge { charge: gamma };
-    let model = ContactModel::new(
-        Material::Piezoelectric(PZT4),
-        Profile::cylinder(radius),
-        eta,
-        electrode,
-    );
+    let model = pzt4(radius, eta, electrode);
     let c = model.compliance;
     let exact = ZhouLee::new(
         p,
@@ -492,16 +494,8 @@ fn coupled_reversal_forms_old_direction_layers_at_the_ends() {
 /// Γ; an insulating punch carries no charge and gives Hertz's width with the compliance y22.
 #[test]
 fn potential_control_and_insulating_punch() {
-    use crate::material::PZT4;
     let (p, gamma, radius) = (2000.0, 6e-7, 0.06);
-    let model = |electrode| {
-        ContactModel::new(
-            Material::Piezoelectric(PZT4),
-            Profile::cylinder(radius),
-            0.3,
-            electrode,
-        )
-    };
+    let model = |electrode| pzt4(radius, 0.3, electrode);
     let charged = model(Electrode::ConductingCharge { charge: gamma });
     let c = charged.compliance;
     let a = Hertz::new(p, radius, c.pressure_compliance()).half_width;
