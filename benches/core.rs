@@ -8,7 +8,7 @@ use fretsim::contact::normal::{NormalOptions, solve_normal};
 use fretsim::contact::pressure::Discretisation;
 use fretsim::contact::tangential::SlipOptions;
 use fretsim::history::{
-    DriverState, LoadHistory, LoadPoint, NoObserver, StepRecord, advance, continue_run,
+    DriverState, LoadHistory, LoadPoint, NoObserver, RunOptions, StepRecord, advance, continue_run,
     run_history, solve_step,
 };
 use fretsim::scenario::{Scenario, default_scenario};
@@ -205,7 +205,7 @@ fn steps_in_a_run(c: &mut Criterion) {
                                 &disc,
                                 &mut d,
                                 &points,
-                                SlipOptions::default(),
+                                RunOptions::default(),
                                 &mut NoObserver,
                                 &mut records,
                             );
@@ -288,7 +288,7 @@ fn cycle(c: &mut Criterion) {
                     &disc,
                     &normal,
                     &history,
-                    SlipOptions::default(),
+                    RunOptions::default(),
                     &mut NoObserver,
                 ))
             })

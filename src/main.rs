@@ -57,7 +57,7 @@ impl fretsim::history::Observer for Progress {
     fn on_step(
         &mut self,
         record: &fretsim::history::StepRecord,
-        _: &fretsim::contact::ContactState,
+        _: fretsim::history::StateView<'_>,
     ) {
         if let (Some(b), true) = (&self.0, record.step > 0) {
             b.set_position(record.step as u64);

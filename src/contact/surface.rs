@@ -29,7 +29,6 @@ impl ContactModel {
     /// p, q, g, σxx0 and Dx0 at x (seed eqs. 64–65, module docs).
     pub fn surface_point(&self, state: &ContactState, x: f64) -> SurfacePoint {
         let c = &self.compliance;
-        let d = &self.field_coefficients;
         let (y23, y33, w13) = c
             .electric
             .map_or((0.0, 0.0, 0.0), |e| (e.y23, e.y33, e.w13));
@@ -38,13 +37,26 @@ impl ContactModel {
         let g = state.charge_at(x);
         let dux = state.strain_at(self, x);
         let dphi = w13 * q + y23 * state.pressure_cauchy(x) + y33 * state.charge_cauchy(x);
+        self.surface_fields(x, (p, q, g), dux, dphi)
+    }
+
+    /// σxx0 and Dx0 (seed eqs. 64–65) from p, q, g, the surface strain `∂ux/∂x` and the
+    /// potential gradient `∂φ/∂x` at x.
+    pub fn surface_fields(
+        &self,
+        x: f64,
+        (p, q, g): (f64, f64, f64),
+        strain: f64,
+        gradient: f64,
+    ) -> SurfacePoint {
+        let d = &self.field_coefficients;
         SurfacePoint {
             x,
             pressure: p,
             traction: q,
             charge: g,
-            sigma_xx: -d.delta1 * p - d.delta2 * g + d.delta3 * dux,
-            d_x: -d.e15_over_c44 * q - d.delta4 * dphi,
+            sigma_xx: -d.delta1 * p - d.delta2 * g + d.delta3 * strain,
+            d_x: -d.e15_over_c44 * q - d.delta4 * gradient,
         }
     }
 }

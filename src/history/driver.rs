@@ -13,13 +13,14 @@ use crate::contact::tangential::{
 };
 use crate::contact::{ContactModel, ContactState};
 
+use super::general::{SolverKind, ZoneCount};
 use super::hints::{
     HISTORY_POINTS, TraceStep, TracedIncrements, Traces, footprint, load_and_geometry,
     phase_start_guess, predict,
 };
 use super::increments::{IncrementInputs, StepIncrements};
 use super::load::LoadPoint;
-use super::record::{Observer, StepFailure, StepRecord};
+use super::record::{Observer, StateView, StepFailure, StepRecord};
 use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
 
 /// Driver state that outlives a step.
@@ -149,7 +150,7 @@ pub(super) fn hold_record(
 ) -> StepRecord {
     let mut rec = record(point.step, point.t, driver, regime, None);
     rec.q = point.q;
-    observer.on_step(&rec, &driver.state);
+    observer.on_step(&rec, StateView::Spectral(&driver.state));
     rec
 }
 
@@ -177,7 +178,7 @@ pub fn finish_step(
     if let Some((phase, memory)) = &solved.new_phase {
         observer.on_phase(*phase, memory);
     }
-    observer.on_step(&rec, &solved.inputs.new);
+    observer.on_step(&rec, StateView::Spectral(&solved.inputs.new));
     rec
 }
 
@@ -436,5 +437,7 @@ pub(super) fn record(
         dissipation: 0.0,
         normal_work: 0.0,
         electric_work: 0.0,
+        solver: SolverKind::Spectral,
+        zones: ZoneCount::of_spectral(s),
     }
 }

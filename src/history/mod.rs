@@ -59,6 +59,7 @@
 //! [`Recalled::admissibility`]: crate::contact::tangential::Recalled::admissibility
 
 mod driver;
+mod general;
 mod hints;
 mod increments;
 mod load;
@@ -67,9 +68,10 @@ mod regime;
 mod run;
 
 pub use driver::{DriverState, Solved, SolvedStep, advance, finish_step, solve_step};
+pub use general::{GeneralRun, RunOptions, SolverChoice, SolverKind, ZoneCount};
 pub use increments::{IncrementInputs, StepIncrements, step_dissipation};
 pub use load::{LoadHistory, LoadPoint};
-pub use record::{NoObserver, Observer, StepFailure, StepRecord};
+pub use record::{NoObserver, Observer, SolvedState, StateView, StepFailure, StepRecord};
 pub use regime::{PhaseEvent, Regime, next_regime, phase_event};
 pub use run::{HistoryFailure, HistoryRun, continue_run, run_history};
 

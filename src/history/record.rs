@@ -2,13 +2,18 @@
 //! each phase's memory ([`Observer`], [`NoObserver`]), and a failed step with its context
 //! ([`StepFailure`]).
 
+use std::sync::Arc;
+
 use serde::Serialize;
 
-use crate::contact::ContactState;
+use crate::contact::SurfacePoint;
+use crate::contact::general::{GeneralState, Solver};
 use crate::contact::memory::Memory;
 use crate::contact::tangential::StepAdmissibility;
+use crate::contact::{ContactModel, ContactState};
 use crate::error::SolveFailure;
 
+use super::general::{SolverKind, ZoneCount};
 use super::regime::Regime;
 
 /// One recorded step.
@@ -55,12 +60,81 @@ pub struct StepRecord {
     pub normal_work: f64,
     /// Work of the electric load in this step, `φ̄0 ΔΓ` (J/m; zero under charge control).
     pub electric_work: f64,
+    /// The solver that took the step.
+    pub solver: SolverKind,
+    /// The zone structure of the state.
+    pub zones: ZoneCount,
+}
+
+/// The committed state of a step, as the solver that took it holds it.
+#[derive(Debug, Clone, Copy)]
+pub enum StateView<'a> {
+    /// A state of the spectral solver.
+    Spectral(&'a ContactState),
+    /// An element state of the general solver, with the solver (its mesh and coefficients).
+    General(&'a Arc<Solver>, &'a GeneralState),
+}
+
+/// An owned [`StateView`], kept for field output.
+#[derive(Debug, Clone)]
+pub enum SolvedState {
+    /// See [`StateView::Spectral`].
+    Spectral(ContactState),
+    /// See [`StateView::General`].
+    General(Arc<Solver>, GeneralState),
+}
+
+impl<'a> StateView<'a> {
+    /// An owned copy.
+    pub fn to_owned(self) -> SolvedState {
+        match self {
+            StateView::Spectral(s) => SolvedState::Spectral(s.clone()),
+            StateView::General(solver, s) => SolvedState::General(Arc::clone(solver), s.clone()),
+        }
+    }
+
+    /// The spectral state, if the spectral solver holds it.
+    pub fn spectral(self) -> Option<&'a ContactState> {
+        match self {
+            StateView::Spectral(s) => Some(s),
+            StateView::General(..) => None,
+        }
+    }
+}
+
+impl SolvedState {
+    /// The borrowed view.
+    pub fn view(&self) -> StateView<'_> {
+        match self {
+            SolvedState::Spectral(s) => StateView::Spectral(s),
+            SolvedState::General(solver, s) => StateView::General(solver, s),
+        }
+    }
+
+    /// Contact centre and half-width (m).
+    pub fn contact(&self) -> (f64, f64) {
+        match self {
+            SolvedState::Spectral(s) => (s.centre, s.half_width),
+            SolvedState::General(_, s) => {
+                let (lo, hi) = s.contact_extent().unwrap_or((0.0, 0.0));
+                (0.5 * (lo + hi), 0.5 * (hi - lo))
+            }
+        }
+    }
+
+    /// p, q, g, σxx0 and Dx0 at x.
+    pub fn surface_point(&self, model: &ContactModel, x: f64) -> SurfacePoint {
+        match self {
+            SolvedState::Spectral(s) => model.surface_point(s, x),
+            SolvedState::General(solver, s) => solver.surface_point(model, s, x),
+        }
+    }
 }
 
 /// Receives the accepted steps (progress bars, writers, test recorders).
 pub trait Observer {
     /// Called once per accepted step with the committed state.
-    fn on_step(&mut self, _record: &StepRecord, _state: &ContactState) {}
+    fn on_step(&mut self, _record: &StepRecord, _state: StateView<'_>) {}
     /// Called when a new phase begins, with the memory that the phase will keep.
     fn on_phase(&mut self, _phase: usize, _memory: &Memory) {}
 }

@@ -164,6 +164,22 @@ pub fn steps_table(records: &[StepRecord], limit: f64) -> Table {
             ("slip_reversal", real(r, |r| r.admissibility.slip_reversal)),
             ("delta_m", real(r, |r| r.displacement)),
             ("dissipation_J_per_m", real(r, |r| r.dissipation)),
+            (
+                "solver",
+                Column::Text(r.iter().map(|r| r.solver.word().into()).collect()),
+            ),
+            (
+                "stick_zones",
+                Column::Count(r.iter().map(|r| r.zones.stick).collect()),
+            ),
+            (
+                "slip_zones",
+                Column::Count(r.iter().map(|r| r.zones.slip).collect()),
+            ),
+            (
+                "slip_sign_changes",
+                Column::Count(r.iter().map(|r| r.zones.sign_changes).collect()),
+            ),
         ],
     }
 }

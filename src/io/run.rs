@@ -9,7 +9,7 @@ use crate::contact::normal::{NormalLoading, NormalOptions, solve_normal};
 use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
 use crate::error::Error;
-use crate::history::StepRecord;
+use crate::history::{RunOptions, SolvedState, SolverKind, StateView, StepRecord};
 use crate::io::csv::{cycles_table, fields_table, steps_table};
 use crate::io::folder::{Protected, RunFolder};
 use crate::io::plots::{PlotScales, family_plots, history_plots, index_html, normal_loading_plots};
@@ -77,31 +77,27 @@ pub struct FieldSet {
 /// (the last step of each phase), the last step, and the steps at the snapshot times.
 pub(crate) struct Snapshots<'a> {
     inner: &'a mut dyn crate::history::Observer,
-    previous: Option<(crate::history::StepRecord, crate::contact::ContactState)>,
-    kept: Vec<(crate::history::StepRecord, crate::contact::ContactState)>,
+    previous: Option<(crate::history::StepRecord, SolvedState)>,
+    kept: Vec<(crate::history::StepRecord, SolvedState)>,
     times: &'a [f64],
     tolerance: f64,
-    at_times: Vec<Option<(crate::history::StepRecord, crate::contact::ContactState)>>,
+    at_times: Vec<Option<(crate::history::StepRecord, SolvedState)>>,
 }
 
 impl crate::history::Observer for Snapshots<'_> {
-    fn on_step(
-        &mut self,
-        record: &crate::history::StepRecord,
-        state: &crate::contact::ContactState,
-    ) {
+    fn on_step(&mut self, record: &crate::history::StepRecord, state: StateView<'_>) {
         if let Some((prev, prev_state)) = self.previous.take()
             && prev.phase != record.phase
             && prev.phase > 0
         {
             self.kept.push((prev, prev_state));
         }
-        self.previous = Some((record.clone(), state.clone()));
+        self.previous = Some((record.clone(), state.to_owned()));
         // The last step at a snapshot time wins (a ramp to a non-zero first point is solved
         // in several steps at the same time).
         for (t, slot) in self.times.iter().zip(self.at_times.iter_mut()) {
             if (record.t - t).abs() <= self.tolerance {
-                *slot = Some((record.clone(), state.clone()));
+                *slot = Some((record.clone(), state.to_owned()));
             }
         }
         self.inner.on_step(record, state);
@@ -181,7 +177,7 @@ pub fn solve(
             &disc,
             &normal,
             history,
-            SlipOptions::default(),
+            RunOptions::new(scenario.solver),
             &mut snapshots,
         ) {
             Ok(run) => records = run.records,
@@ -203,20 +199,17 @@ pub fn solve(
         .as_ref()
         .map(|_| history_summary(&records, failure.as_ref(), &cycles, verdict, tolerance));
     // Sampled fields: the end of normal loading, then each snapshot time reached.
-    let sample = |state: &crate::contact::ContactState| -> Vec<SurfacePoint> {
-        field_points(
-            state.centre,
-            state.half_width,
-            scenario.raw.output.field_points,
-        )
-        .into_iter()
-        .map(|x| model.surface_point(state, x))
-        .collect()
+    let sample = |state: &SolvedState| -> Vec<SurfacePoint> {
+        let (centre, half_width) = state.contact();
+        field_points(centre, half_width, scenario.raw.output.field_points)
+            .into_iter()
+            .map(|x| state.surface_point(model, x))
+            .collect()
     };
     let mut fields = vec![FieldSet {
         stem: "normal_loading".into(),
         label: "end of normal loading".into(),
-        points: sample(&normal.state),
+        points: sample(&SolvedState::Spectral(normal.state.clone())),
     }];
     let (at_snapshots, snapshot_rows) = snapshot_fields(
         scenario,
@@ -275,12 +268,12 @@ fn gap_warning(scenario: &Scenario, normal: &NormalLoading) -> Option<String> {
     ))
 }
 
-/// The warning for steps accepted with a residual above the solver tolerance.
+/// The warning for steps the spectral solver accepted with a residual above its tolerance.
 fn stalled_warning(records: &[StepRecord]) -> Option<String> {
     let solver_tolerance = SlipOptions::default().tolerance;
     let stalled: Vec<&StepRecord> = records
         .iter()
-        .filter(|r| r.residual >= solver_tolerance)
+        .filter(|r| r.solver == SolverKind::Spectral && r.residual >= solver_tolerance)
         .collect();
     let worst = stalled
         .iter()
@@ -300,8 +293,8 @@ fn stalled_warning(records: &[StepRecord]) -> Option<String> {
 /// reached.
 fn snapshot_fields(
     scenario: &Scenario,
-    at_times: &[Option<(StepRecord, crate::contact::ContactState)>],
-    sample: &dyn Fn(&crate::contact::ContactState) -> Vec<SurfacePoint>,
+    at_times: &[Option<(StepRecord, SolvedState)>],
+    sample: &dyn Fn(&SolvedState) -> Vec<SurfacePoint>,
     records: &[StepRecord],
     warnings: &mut Vec<String>,
 ) -> (Vec<FieldSet>, Vec<SnapshotSummary>) {

@@ -7,6 +7,7 @@ use crate::analysis::{CycleRow, Verdict};
 use crate::contact::ContactModel;
 use crate::contact::normal::NormalLoading;
 use crate::halfplane::{PaperCoefficients, SurfaceCompliance, SurfaceFieldCoefficients};
+use crate::history::SolverKind;
 use crate::scenario::{RawScenario, Scenario};
 
 /// Constants derived from the material, reported in `summary.json`.
@@ -166,8 +167,10 @@ pub struct SolverStatistics {
     pub max_newton_iterations: usize,
     /// Residual evaluations summed over the history (`evaluations` in `steps.csv`).
     pub residual_evaluations: usize,
-    /// Largest final residual of a step.
+    /// Largest final residual of a step of the spectral solver.
     pub max_residual: Option<f64>,
+    /// Steps taken by the general element solver (`solver` in `steps.csv`).
+    pub general_steps: usize,
     /// Worst `stick_excess` of a step (≤ 0 when admissible).
     pub worst_stick_excess: Option<f64>,
     /// Worst `slip_reversal` of a step (≤ 0 when admissible).
@@ -224,7 +227,17 @@ pub(crate) fn solver_statistics(
         newton_iterations: steps.clone().map(|r| r.iterations).sum(),
         max_newton_iterations: steps.clone().map(|r| r.iterations).max().unwrap_or(0),
         residual_evaluations: steps.map(|r| r.newton_iterations).sum(),
-        max_residual: max(&|r| r.residual),
+        max_residual: max(&|r| {
+            if r.solver == SolverKind::Spectral {
+                r.residual
+            } else {
+                f64::NAN
+            }
+        }),
+        general_steps: records
+            .iter()
+            .filter(|r| r.solver == SolverKind::General)
+            .count(),
         worst_stick_excess: max(&|r| r.admissibility.stick_excess),
         worst_slip_reversal: max(&|r| r.admissibility.slip_reversal),
     }

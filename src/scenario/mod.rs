@@ -32,6 +32,8 @@ pub struct Scenario {
     pub normal_load: f64,
     /// M.
     pub collocation_points: usize,
+    /// Which solver takes the tangential steps (`numerics.solver`).
+    pub solver: crate::history::SolverChoice,
     /// The tangential load history in N/m, if any, with a point added at every snapshot time
     /// that is not already a step time (Q(t) unchanged).
     pub history: Option<crate::history::LoadHistory>,
@@ -231,6 +233,7 @@ fn build(
         model,
         normal_load: raw.normal_load,
         collocation_points: raw.numerics.collocation_points,
+        solver: raw.numerics.solver,
         history,
         snapshots: raw.output.snapshots.clone(),
         time_tolerance,

@@ -208,6 +208,10 @@ pub struct RawNumerics {
     /// Carry the square-root kinks of p and w at the stick ends in closed form (default true).
     #[serde(default = "default_stick_end_kinks")]
     pub stick_end_kinks: bool,
+    /// Which solver takes the tangential steps: `auto` (default: the spectral solver, and the
+    /// general element solver for the steps it cannot take), `spectral` or `general`.
+    #[serde(default)]
+    pub solver: crate::history::SolverChoice,
 }
 
 pub(super) fn default_stick_end_kinks() -> bool {
@@ -228,6 +232,7 @@ impl Default for RawNumerics {
             collocation_points: default_m(),
             cycle_tolerance: default_cycle_tolerance(),
             stick_end_kinks: default_stick_end_kinks(),
+            solver: crate::history::SolverChoice::default(),
         }
     }
 }

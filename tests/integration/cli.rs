@@ -163,7 +163,7 @@ fn read_summary(dir: &Path) -> Summary {
 const FIELDS_HEADER: &str = "x_m,p_Pa,q_Pa,g_C_per_m2,sigma_xx_Pa,d_x_C_per_m2";
 const STEPS_HEADER: &str = "step,t_s,Q_N_per_m,Q_over_etaP,regime,phase,a_m,e_m,stick_lo_m,stick_hi_m,\
 left_slip_sign,right_slip_sign,newton_iterations,evaluations,residual,stick_excess,slip_reversal,\
-delta_m,dissipation_J_per_m";
+delta_m,dissipation_J_per_m,solver,stick_zones,slip_zones,slip_sign_changes";
 const CYCLES_HEADER: &str = "cycle,first_step,last_step,Q_start_N_per_m,Q_min_N_per_m,\
 Q_end_N_per_m,loop_area_J_per_m,friction_work_J_per_m,normal_work_J_per_m,electric_work_J_per_m,\
 delta_at_max_m,delta_at_min_m,stick_lo_at_max_m,stick_hi_at_max_m,stick_lo_at_min_m,\
@@ -994,6 +994,7 @@ fn failing_history() -> String {
   "friction": 0.1,
   "normal_load": 2000.0,
   "tangential_history": { "points": [[0.0, 0.0], [1.0, 0.3], [2.0, 0.5], [3.0, 0.3]] },
+  "numerics": { "solver": "spectral" },
   "output": { "snapshots": [1.0, 2.0, 3.0], "field_points": 40 }
 }"#
     .to_string()
@@ -1117,6 +1118,7 @@ fn stalled_step_is_accepted_below_the_stall_tolerance_and_reported() {
     )
     .unwrap();
     raw["friction"] = serde_json::json!(0.4);
+    raw["numerics"] = serde_json::json!({ "solver": "spectral" });
     raw["output"] = serde_json::json!({ "turning_point_fields": false });
     let file = tmp.path().join("stalls.json");
     std::fs::write(&file, raw.to_string()).unwrap();

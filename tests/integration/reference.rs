@@ -91,7 +91,7 @@ fn run_points(
         disc,
         normal,
         &history,
-        SlipOptions::default(),
+        fretsim::history::RunOptions::spectral(SlipOptions::default()),
         &mut NoObserver,
     )
     .unwrap()
@@ -132,7 +132,7 @@ fn records_of(
         &b.disc,
         &b.normal,
         &history,
-        options,
+        fretsim::history::RunOptions::spectral(options),
         &mut NoObserver,
     )
     .unwrap()
@@ -641,9 +641,16 @@ fn reference_cattaneo_mindlin_deresiewicz_masing() {
         let normal = solve_normal(&model, &disc, p_load, NormalOptions::default()).unwrap();
         let mut recorder = Recorder::default();
         let opts = SlipOptions::default();
-        let records = run_history(&model, &disc, &normal, &history, opts, &mut recorder)
-            .unwrap()
-            .records;
+        let records = run_history(
+            &model,
+            &disc,
+            &normal,
+            &history,
+            fretsim::history::RunOptions::spectral(opts),
+            &mut recorder,
+        )
+        .unwrap()
+        .records;
         let a = exact.half_width;
         let scale = model.friction * exact.peak_pressure;
         let (mut err_c, mut err_q) = (0.0f64, 0.0f64);
@@ -708,8 +715,9 @@ struct Recorder {
 }
 
 impl fretsim::history::Observer for Recorder {
-    fn on_step(&mut self, _r: &fretsim::history::StepRecord, s: &fretsim::contact::ContactState) {
-        self.states.push(s.clone());
+    fn on_step(&mut self, _r: &fretsim::history::StepRecord, s: fretsim::history::StateView<'_>) {
+        self.states
+            .push(s.spectral().expect("a spectral run").clone());
     }
 }
 
@@ -1473,7 +1481,7 @@ fn pipelined_history_matches_sequential_steps() {
         &b.disc,
         &b.normal,
         &history,
-        options,
+        fretsim::history::RunOptions::spectral(options),
         &mut NoObserver,
     )
     .unwrap();
@@ -1506,7 +1514,7 @@ fn pipelined_history_matches_sequential_steps() {
         &b.disc,
         &mut part,
         &points[2..],
-        options,
+        fretsim::history::RunOptions::spectral(options),
         &mut NoObserver,
         &mut records,
     );
@@ -1875,8 +1883,9 @@ fn batched_fields_equal_the_one_point_fields() {
     use fretsim::history::{LoadHistory, Observer, StepRecord, run_history};
     struct States(Vec<ContactState>, Vec<Memory>);
     impl Observer for States {
-        fn on_step(&mut self, _: &StepRecord, state: &ContactState) {
-            self.0.push(state.clone());
+        fn on_step(&mut self, _: &StepRecord, state: fretsim::history::StateView<'_>) {
+            self.0
+                .push(state.spectral().expect("a spectral run").clone());
         }
         fn on_phase(&mut self, _: usize, memory: &Memory) {
             self.1.push(memory.clone());
@@ -1894,7 +1903,7 @@ fn batched_fields_equal_the_one_point_fields() {
         &b.disc,
         &b.normal,
         &history,
-        SlipOptions::default(),
+        fretsim::history::RunOptions::spectral(SlipOptions::default()),
         &mut states,
     )
     .unwrap();
@@ -2030,9 +2039,16 @@ fn remembered_end_next_to_a_new_stick_end_stays_converged() {
             let normal =
                 solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
             let options = SlipOptions::default();
-            run_history(&sc.model, &disc, &normal, history, options, &mut NoObserver)
-                .unwrap()
-                .records
+            run_history(
+                &sc.model,
+                &disc,
+                &normal,
+                history,
+                fretsim::history::RunOptions::spectral(options),
+                &mut NoObserver,
+            )
+            .unwrap()
+            .records
         })
         .collect();
     assert_eq!(runs[0].len(), 61);
@@ -2087,15 +2103,18 @@ fn a_recalled_step_from_another_start_computes_its_own_increments() {
         max_step: 0.15 * b.lim,
     };
     let mut recorder = Recorder::default();
-    let run = fretsim::history::run_history(
-        &b.model,
-        &b.disc,
-        &b.normal,
-        &history,
-        fretsim::contact::tangential::SlipOptions::default(),
-        &mut recorder,
-    )
-    .unwrap();
+    let run =
+        fretsim::history::run_history(
+            &b.model,
+            &b.disc,
+            &b.normal,
+            &history,
+            fretsim::history::RunOptions::spectral(
+                fretsim::contact::tangential::SlipOptions::default(),
+            ),
+            &mut recorder,
+        )
+        .unwrap();
     let (records, states) = (&run.records, &recorder.states);
     // The first step after step `from` to `k` × 0.05 ηP.
     let step_to =

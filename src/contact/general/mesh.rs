@@ -60,6 +60,12 @@ impl Mesh {
         Self { edges }
     }
 
+    /// The width of the element that holds x (the nearest element outside the mesh) (m).
+    pub fn width_at(&self, x: f64) -> f64 {
+        let k = self.edges.partition_point(|&e| e <= x);
+        self.width(k.clamp(1, self.len()) - 1)
+    }
+
     /// A uniform mesh of `[lo, hi]` with `n` elements.
     pub fn uniform(lo: f64, hi: f64, n: usize) -> Self {
         let edges = (0..=n)

@@ -103,6 +103,7 @@ pub mod influence;
 pub mod mesh;
 
 mod dense;
+mod handover;
 mod normal;
 mod tangential;
 

@@ -1,0 +1,457 @@
+//! Steps taken by the general element solver ([`crate::contact::general`]): the run that
+//! carries its state ([`GeneralRun`]), started from a committed spectral state by
+//! [`GeneralRun::handover`], and the record of each of its steps.
+//!
+//! # Records
+//! The contact ends are the outer edges of the outermost contact elements, the stick zone the
+//! longest run of stuck elements, and the slip signs those of the slip zones beside it (0 where
+//! the stick zone reaches the contact end). The zone structure — the runs of stuck elements
+//! and of elements slipping either way, and how often the slip sign changes across the
+//! contact — is in [`ZoneCount`]. The step's increments follow from its two states:
+//!
+//! ```text
+//! Δδ = Δδx (a stuck point moves with the punch),   D = −Σ w_i ½(q_i + q_i') s_i,
+//! W_P = P Δδz,                                     W_e = φ0 ΔΓ (potential control; else 0)
+//! ```
+//!
+//! with `s_i` the element's mean slip in the step (the half-plane relative to the punch), so
+//! that D ≥ 0 where q opposes the slip.
+//!
+//! # Mesh
+//! The band `c ± 1.25a` of the state handed over, graded towards its contact ends
+//! (elements of [`END_SIZE`]·a there, growing by [`GROWTH`] per element up to
+//! [`INNER_SIZE`]·a). The mesh stays for the rest of the run: the state is the slip reference
+//! of the next step, and it belongs to its mesh.
+
+use std::sync::Arc;
+
+use serde::{Deserialize, Serialize};
+
+use crate::contact::general::{
+    ElementState, Focus, GeneralState, Loads, Mesh, Options, Solver, StepReport,
+};
+use crate::contact::tangential::{SlipOptions, StepAdmissibility};
+use crate::contact::{ContactModel, ContactState, Electrode};
+use crate::error::SolveFailure;
+
+use super::driver::DriverState;
+use super::load::LoadPoint;
+use super::record::{StepFailure, StepRecord};
+use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
+
+/// Element size at the contact ends of the handed-over state, relative to a.
+pub const END_SIZE: f64 = 5e-4;
+/// Growth of the element size per element away from the contact ends.
+pub const GROWTH: f64 = 1.06;
+/// Largest element, relative to a.
+pub const INNER_SIZE: f64 = 6e-3;
+
+/// Which solver takes the tangential steps (`numerics.solver`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum SolverChoice {
+    /// The spectral solver, and the general solver for the steps it cannot take
+    /// ([`super::continue_run`]).
+    #[default]
+    Auto,
+    /// The spectral solver only: a step it cannot take stops the run.
+    Spectral,
+    /// The general solver for every tangential step (the normal loading stays Spence's
+    /// self-similar solution of the spectral solver).
+    General,
+}
+
+/// Options of a run.
+#[derive(Debug, Clone, Copy)]
+pub struct RunOptions {
+    /// The spectral solver's options.
+    pub slip: SlipOptions,
+    /// Which solver takes the steps.
+    pub solver: SolverChoice,
+}
+
+impl RunOptions {
+    /// The default options for a choice of solver. Under [`SolverChoice::Auto`] the spectral
+    /// solver accepts no step at a stalled residual (`stall_tolerance` 0): the general solver
+    /// takes such a step instead.
+    pub fn new(solver: SolverChoice) -> Self {
+        let slip = match solver {
+            SolverChoice::Auto => SlipOptions {
+                stall_tolerance: 0.0,
+                ..SlipOptions::default()
+            },
+            _ => SlipOptions::default(),
+        };
+        Self { slip, solver }
+    }
+}
+
+impl RunOptions {
+    /// The spectral solver only, with its options.
+    pub fn spectral(slip: SlipOptions) -> Self {
+        Self {
+            slip,
+            solver: SolverChoice::Spectral,
+        }
+    }
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        Self::new(SolverChoice::Auto)
+    }
+}
+
+/// Which solver took a step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum SolverKind {
+    /// The paper's spectral solver (one central stick zone between two slip zones).
+    #[default]
+    Spectral,
+    /// The general element solver (any zone structure).
+    General,
+}
+
+impl SolverKind {
+    /// The word in `steps.csv`.
+    pub fn word(self) -> &'static str {
+        match self {
+            SolverKind::Spectral => "spectral",
+            SolverKind::General => "general",
+        }
+    }
+}
+
+/// The zone structure of a state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct ZoneCount {
+    /// Stick zones.
+    pub stick: usize,
+    /// Slip zones (either direction).
+    pub slip: usize,
+    /// Changes of the slip direction from one slip zone to the next, left to right.
+    pub sign_changes: usize,
+}
+
+impl ZoneCount {
+    /// The zones of an element state.
+    pub fn of_elements(state: &GeneralState) -> Self {
+        let mut count = Self::default();
+        let mut last_slip: Option<ElementState> = None;
+        for (code, _, _) in state.zones() {
+            match code {
+                ElementState::Exterior => {}
+                ElementState::Stick => count.stick += 1,
+                slip => {
+                    count.slip += 1;
+                    if last_slip.is_some_and(|s| s != slip) {
+                        count.sign_changes += 1;
+                    }
+                    last_slip = Some(slip);
+                }
+            }
+        }
+        count
+    }
+
+    /// The zones of a spectral state: one stick zone between up to two slip zones.
+    pub fn of_spectral(state: &ContactState) -> Self {
+        let t = &state.traction;
+        let Some(zone) = &t.stick else {
+            return Self::default();
+        };
+        let slipping = t.left_sign != 0.0 || t.right_sign != 0.0;
+        let (lo, hi) = (
+            state.centre - state.half_width,
+            state.centre + state.half_width,
+        );
+        let left = slipping && zone.lo > lo;
+        let right = slipping && zone.hi < hi;
+        Self {
+            stick: 1,
+            slip: usize::from(left) + usize::from(right),
+            sign_changes: usize::from(left && right && t.left_sign != t.right_sign),
+        }
+    }
+}
+
+/// A run of steps taken by the general solver.
+#[derive(Debug, Clone)]
+pub struct GeneralRun {
+    solver: Arc<Solver>,
+    /// The committed element state.
+    pub state: GeneralState,
+    /// δ of the state minus its rigid shift δx (m).
+    offset: f64,
+    /// Slip sign of the current phase.
+    phase_sign: Option<f64>,
+    /// Phase number.
+    pub phase: usize,
+    /// Phases begun since the handover.
+    pub phases_begun: usize,
+    /// Steps taken.
+    pub steps: usize,
+    /// Whether the first phase begun began at the first step (from the handed-over state).
+    pub first_began_at_handover: bool,
+}
+
+/// The loads of a state at tangential load `q`.
+pub fn loads_of(model: &ContactModel, normal_load: f64, q: f64) -> Loads {
+    let electric = match model.electrode {
+        Electrode::ConductingCharge { charge } => charge,
+        Electrode::ConductingPotential { potential } => potential,
+        Electrode::None | Electrode::Insulating => 0.0,
+    };
+    Loads {
+        normal: normal_load,
+        tangential: q,
+        electric,
+    }
+}
+
+/// The mesh for a run handed over at a state (module docs).
+pub fn mesh_for(state: &ContactState) -> Mesh {
+    let (c, a) = (state.centre, state.half_width);
+    let focus = [
+        Focus {
+            at: c - a,
+            size: END_SIZE * a,
+        },
+        Focus {
+            at: c + a,
+            size: END_SIZE * a,
+        },
+    ];
+    Mesh::graded(c - 1.25 * a, c + 1.25 * a, &focus, GROWTH, INNER_SIZE * a)
+}
+
+impl GeneralRun {
+    /// Take over from the driver's committed state.
+    pub fn handover(model: &ContactModel, driver: &DriverState) -> Self {
+        let s = &driver.state;
+        let solver = Arc::new(Solver::new(model, mesh_for(s), Options::default()));
+        let loads = loads_of(model, s.normal_load, s.tangential_load);
+        let state = solver.adopt(s, loads, 0.0);
+        Self {
+            solver,
+            state,
+            offset: driver.displacement,
+            phase_sign: driver.phase_sign,
+            phase: driver.phase,
+            phases_begun: 0,
+            steps: 0,
+            first_began_at_handover: false,
+        }
+    }
+
+    /// The solver.
+    pub fn solver(&self) -> &Arc<Solver> {
+        &self.solver
+    }
+
+    /// Punch displacement δ of the committed state (m).
+    pub fn displacement(&self) -> f64 {
+        self.offset + self.state.shift
+    }
+
+    /// Take one load step and commit it; its record.
+    pub fn step(
+        &mut self,
+        model: &ContactModel,
+        point: LoadPoint,
+    ) -> Result<StepRecord, StepFailure> {
+        let LoadPoint { step, t, q } = point;
+        let old = &self.state;
+        let limit = model.friction * old.loads.normal;
+        let regime = next_regime(q - old.loads.tangential, 1e-12 * limit);
+        let Some(_) = regime.slip_sign() else {
+            let mut rec = self.record(step, t, regime, None);
+            rec.q = q;
+            return Ok(rec);
+        };
+        let loads = Loads {
+            tangential: q,
+            ..old.loads
+        };
+        let (new, report) = self
+            .solver
+            .step(old, loads)
+            .map_err(|failure| StepFailure {
+                step,
+                t,
+                q,
+                regime,
+                failure,
+            })?;
+        if new.length_of(ElementState::Stick) == 0.0 {
+            return Err(StepFailure {
+                step,
+                t,
+                q,
+                regime,
+                failure: SolveFailure::NoAdmissibleState {
+                    reason: "no element sticks: the contact slides as a whole".into(),
+                },
+            });
+        }
+        if let PhaseEvent::Begin(sign) = phase_event(self.phase_sign, regime) {
+            self.phase_sign = Some(sign);
+            self.phase += 1;
+            if self.phases_begun == 0 && self.steps == 0 {
+                self.first_began_at_handover = true;
+            }
+            self.phases_begun += 1;
+        }
+        let increments = Increments::between(model, &self.state, &new);
+        self.state = new;
+        self.steps += 1;
+        let mut rec = self.record(step, t, regime, Some(&report));
+        rec.dissipation = increments.dissipation;
+        rec.normal_work = increments.normal_work;
+        rec.electric_work = increments.electric_work;
+        Ok(rec)
+    }
+
+    /// The record of the committed state, with zero increments.
+    fn record(
+        &self,
+        step: usize,
+        t: f64,
+        regime: Regime,
+        report: Option<&StepReport>,
+    ) -> StepRecord {
+        let s = &self.state;
+        let (lo, hi) = s.contact_extent().unwrap_or((0.0, 0.0));
+        let zones = s.zones();
+        let main = zones
+            .iter()
+            .enumerate()
+            .filter(|(_, z)| z.0 == ElementState::Stick)
+            .max_by(|x, y| (x.1.2 - x.1.1).total_cmp(&(y.1.2 - y.1.1)))
+            .map(|(k, _)| k);
+        let sign_of = |k: Option<usize>| match k.map(|k| zones[k].0) {
+            Some(ElementState::SlipNegative) => 1.0,
+            Some(ElementState::SlipPositive) => -1.0,
+            _ => 0.0,
+        };
+        let (stick_lo, stick_hi, left, right) = match main {
+            Some(k) => (
+                zones[k].1,
+                zones[k].2,
+                sign_of(k.checked_sub(1)),
+                sign_of(Some(k + 1).filter(|&j| j < zones.len())),
+            ),
+            None => (0.5 * (lo + hi), 0.5 * (lo + hi), 0.0, 0.0),
+        };
+        StepRecord {
+            step,
+            t,
+            q: s.loads.tangential,
+            regime,
+            phase: self.phase,
+            half_width: 0.5 * (hi - lo),
+            eccentricity: -0.5 * (lo + hi),
+            stick_lo,
+            stick_hi,
+            left_slip_sign: left,
+            right_slip_sign: right,
+            iterations: report.map_or(0, |r| r.outer_iterations),
+            newton_iterations: report.map_or(0, |r| r.tangential_iterations),
+            residual: report.map_or(0.0, |r| {
+                if r.outer_iterations > 1 {
+                    r.residual
+                } else {
+                    0.0
+                }
+            }),
+            admissibility: admissibility(s, self.solver.friction()),
+            displacement: self.displacement(),
+            dissipation: 0.0,
+            normal_work: 0.0,
+            electric_work: 0.0,
+            solver: SolverKind::General,
+            zones: ZoneCount::of_elements(s),
+        }
+    }
+}
+
+/// The checks of an element state, in the measures of the spectral solver's checks: stick
+/// excess `max (|q| − ηp)/(η p_max)` over stuck elements, slip reversal `max q s / max |q s|`
+/// over slipping elements (q opposes the slip: ≤ 0), and `min p/p_max` over the contact.
+fn admissibility(s: &GeneralState, eta: f64) -> StepAdmissibility {
+    let pmax = s.pressure.iter().cloned().fold(0.0, f64::max);
+    let mut out = StepAdmissibility {
+        stick_excess: f64::NEG_INFINITY,
+        slip_reversal: f64::NEG_INFINITY,
+        min_pressure: f64::INFINITY,
+        worst_at: [0.0; 3],
+    };
+    let work_scale = s
+        .shear
+        .iter()
+        .zip(&s.slip)
+        .map(|(q, d)| (q * d).abs())
+        .fold(0.0, f64::max);
+    for (i, &code) in s.codes.iter().enumerate() {
+        let x = s.mesh.centre(i);
+        let (p, q, d) = (s.pressure[i], s.shear[i], s.slip[i]);
+        match code {
+            ElementState::Exterior => continue,
+            ElementState::Stick => {
+                let excess = (q.abs() - eta * p) / (eta * pmax);
+                if excess > out.stick_excess {
+                    out.stick_excess = excess;
+                    out.worst_at[0] = x;
+                }
+            }
+            _ => {
+                let reversal = if work_scale > 0.0 {
+                    q * d / work_scale
+                } else {
+                    0.0
+                };
+                if reversal > out.slip_reversal {
+                    out.slip_reversal = reversal;
+                    out.worst_at[1] = x;
+                }
+            }
+        }
+        if p / pmax < out.min_pressure {
+            out.min_pressure = p / pmax;
+            out.worst_at[2] = x;
+        }
+    }
+    let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
+    out.stick_excess = finite(out.stick_excess);
+    out.slip_reversal = finite(out.slip_reversal);
+    out.min_pressure = finite(out.min_pressure);
+    out
+}
+
+/// The increments of a step (module docs).
+struct Increments {
+    dissipation: f64,
+    normal_work: f64,
+    electric_work: f64,
+}
+
+impl Increments {
+    fn between(model: &ContactModel, old: &GeneralState, new: &GeneralState) -> Self {
+        let widths = new.mesh.widths();
+        let dissipation = -(0..widths.len())
+            .map(|i| widths[i] * 0.5 * (old.shear[i] + new.shear[i]) * new.slip[i])
+            .sum::<f64>();
+        let electric_work = match model.electrode {
+            Electrode::ConductingPotential { potential } => {
+                potential * (new.resultants().2 - old.resultants().2)
+            }
+            _ => 0.0,
+        };
+        Self {
+            dissipation,
+            normal_work: new.loads.normal * (new.approach - old.approach),
+            electric_work,
+        }
+    }
+}
