@@ -171,7 +171,7 @@ impl ZoneCount {
         Self {
             stick: 1,
             slip: usize::from(left) + usize::from(right),
-            sign_changes: usize::from(left && right && t.left_sign != t.right_sign),
+            sign_changes: usize::from(left && right && t.left_sign * t.right_sign < 0.0),
         }
     }
 }

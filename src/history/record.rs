@@ -79,17 +79,19 @@ pub enum StateView<'a> {
 #[derive(Debug, Clone)]
 pub enum SolvedState {
     /// See [`StateView::Spectral`].
-    Spectral(ContactState),
+    Spectral(Box<ContactState>),
     /// See [`StateView::General`].
-    General(Arc<Solver>, GeneralState),
+    General(Arc<Solver>, Box<GeneralState>),
 }
 
 impl<'a> StateView<'a> {
     /// An owned copy.
     pub fn to_owned(self) -> SolvedState {
         match self {
-            StateView::Spectral(s) => SolvedState::Spectral(s.clone()),
-            StateView::General(solver, s) => SolvedState::General(Arc::clone(solver), s.clone()),
+            StateView::Spectral(s) => SolvedState::Spectral(Box::new(s.clone())),
+            StateView::General(solver, s) => {
+                SolvedState::General(Arc::clone(solver), Box::new(s.clone()))
+            }
         }
     }
 

@@ -209,7 +209,7 @@ pub fn solve(
     let mut fields = vec![FieldSet {
         stem: "normal_loading".into(),
         label: "end of normal loading".into(),
-        points: sample(&SolvedState::Spectral(normal.state.clone())),
+        points: sample(&SolvedState::Spectral(Box::new(normal.state.clone()))),
     }];
     let (at_snapshots, snapshot_rows) = snapshot_fields(
         scenario,

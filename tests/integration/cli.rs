@@ -137,6 +137,7 @@ struct Solver {
     max_newton_iterations: usize,
     residual_evaluations: usize,
     max_residual: Option<f64>,
+    general_steps: usize,
     worst_stick_excess: Option<f64>,
     worst_slip_reversal: Option<f64>,
 }

@@ -2,5 +2,6 @@
 
 mod cli;
 mod fuzz;
+mod hybrid;
 mod output_safety;
 mod reference;
