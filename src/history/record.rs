@@ -137,6 +137,9 @@ impl SolvedState {
 pub trait Observer {
     /// Called once per accepted step with the committed state.
     fn on_step(&mut self, _record: &StepRecord, _state: StateView<'_>) {}
+    /// Called when the general solver takes over from the spectral solver, with the step the
+    /// spectral solver could not take.
+    fn on_handover(&mut self, _failure: &StepFailure) {}
     /// Called when a new phase begins, with the memory that the phase will keep.
     fn on_phase(&mut self, _phase: usize, _memory: &Memory) {}
 }

@@ -122,6 +122,7 @@ pub fn continue_run(
             if options.solver == SolverChoice::Spectral {
                 return Some(failure);
             }
+            observer.on_handover(&failure);
             general = Some(GeneralRun::handover(model, driver));
             continue;
         };

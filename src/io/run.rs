@@ -14,7 +14,8 @@ use crate::io::csv::{cycles_table, fields_table, steps_table};
 use crate::io::folder::{Protected, RunFolder};
 use crate::io::plots::{PlotScales, family_plots, history_plots, index_html, normal_loading_plots};
 use crate::io::summary::{
-    Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary, solver_statistics,
+    Handover, Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary,
+    solver_statistics,
 };
 use crate::scenario::Scenario;
 
@@ -82,6 +83,7 @@ pub(crate) struct Snapshots<'a> {
     times: &'a [f64],
     tolerance: f64,
     at_times: Vec<Option<(crate::history::StepRecord, SolvedState)>>,
+    handovers: Vec<Handover>,
 }
 
 impl crate::history::Observer for Snapshots<'_> {
@@ -105,6 +107,16 @@ impl crate::history::Observer for Snapshots<'_> {
 
     fn on_phase(&mut self, phase: usize, memory: &crate::contact::memory::Memory) {
         self.inner.on_phase(phase, memory);
+    }
+
+    fn on_handover(&mut self, failure: &crate::history::StepFailure) {
+        self.handovers.push(Handover {
+            step: failure.step,
+            t: failure.t,
+            q: failure.q,
+            reason: failure.failure.to_string(),
+        });
+        self.inner.on_handover(failure);
     }
 }
 
@@ -170,6 +182,7 @@ pub fn solve(
         times: &scenario.snapshots,
         tolerance: scenario.time_tolerance,
         at_times: vec![None; scenario.snapshots.len()],
+        handovers: Vec::new(),
     };
     if let Some(history) = &scenario.history {
         match crate::history::run_history(
@@ -230,7 +243,7 @@ pub fn solve(
         normal_loading: normal_summary(model, &normal),
         history: history_summary,
         snapshots: snapshot_rows,
-        solver: solver_statistics(scenario, &normal, &records),
+        solver: solver_statistics(scenario, &normal, &records, snapshots.handovers),
         warnings,
     };
     // Turning points and the last step, unless switched off.

@@ -171,10 +171,26 @@ pub struct SolverStatistics {
     pub max_residual: Option<f64>,
     /// Steps taken by the general element solver (`solver` in `steps.csv`).
     pub general_steps: usize,
+    /// Each step at which the general solver took over, with the reason the spectral solver
+    /// could not take it.
+    pub handovers: Vec<Handover>,
     /// Worst `stick_excess` of a step (≤ 0 when admissible).
     pub worst_stick_excess: Option<f64>,
     /// Worst `slip_reversal` of a step (≤ 0 when admissible).
     pub worst_slip_reversal: Option<f64>,
+}
+
+/// A step that the spectral solver could not take, taken by the general solver.
+#[derive(Debug, Clone, Serialize)]
+pub struct Handover {
+    /// Step number.
+    pub step: usize,
+    /// Time (s).
+    pub t: f64,
+    /// Tangential load Q (N/m).
+    pub q: f64,
+    /// Why the spectral solver could not take it.
+    pub reason: String,
 }
 
 /// A field snapshot at a requested time, in `summary.json`.
@@ -210,6 +226,7 @@ pub(crate) fn solver_statistics(
     scenario: &Scenario,
     normal: &NormalLoading,
     records: &[crate::history::StepRecord],
+    handovers: Vec<Handover>,
 ) -> SolverStatistics {
     let steps = records.iter().skip(1);
     let max = |f: &dyn Fn(&crate::history::StepRecord) -> f64| {
@@ -238,6 +255,7 @@ pub(crate) fn solver_statistics(
             .iter()
             .filter(|r| r.solver == SolverKind::General)
             .count(),
+        handovers,
         worst_stick_excess: max(&|r| r.admissibility.stick_excess),
         worst_slip_reversal: max(&|r| r.admissibility.slip_reversal),
     }

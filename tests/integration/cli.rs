@@ -138,6 +138,7 @@ struct Solver {
     residual_evaluations: usize,
     max_residual: Option<f64>,
     general_steps: usize,
+    handovers: Vec<serde_json::Value>,
     worst_stick_excess: Option<f64>,
     worst_slip_reversal: Option<f64>,
 }

@@ -67,6 +67,9 @@ fn figure3_history_at_eta_0_1_completes_and_the_spectral_solver_resumes() {
         "the spectral solver resumed"
     );
     assert_eq!(auto.summary.solver.general_steps, general.len());
+    let handovers = &auto.summary.solver.handovers;
+    assert_eq!(handovers.len(), 1, "{handovers:?}");
+    assert_eq!(handovers[0].step, 21);
     // δ and the dissipation go on across the handovers: the punch moves back in every step of
     // the reversal, and every step dissipates.
     for w in r[20..].windows(2) {
