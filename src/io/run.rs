@@ -17,7 +17,7 @@ use crate::io::summary::{
     Handover, Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary,
     solver_statistics,
 };
-use crate::scenario::Scenario;
+use crate::scenario::{Scenario, TurningFields};
 
 /// What a run produced.
 #[derive(Debug)]
@@ -37,8 +37,8 @@ pub struct Solution {
     pub summary: Summary,
     /// The sampled fields: the end of normal loading, then one set per snapshot time reached.
     pub fields: Vec<FieldSet>,
-    /// The fields at the turning points and the last step (empty when
-    /// `output.turning_point_fields` is off).
+    /// The fields at the turning points that `output.turning_point_fields` asks for and at
+    /// the last step.
     pub turning_fields: Vec<FieldSet>,
     /// One record per accepted step (step 0 is the end of normal loading).
     pub records: Vec<crate::history::StepRecord>,
@@ -75,7 +75,8 @@ pub struct FieldSet {
 }
 
 /// Keeps, while the history runs, the states that the field files need: the turning points
-/// (the last step of each phase), the last step, and the steps at the snapshot times.
+/// (the last step of each phase) that `output.turning_point_fields` asks for, the last step,
+/// and the steps at the snapshot times. A long run keeps a few states, not one per phase.
 pub(crate) struct Snapshots<'a> {
     inner: &'a mut dyn crate::history::Observer,
     previous: Option<(crate::history::StepRecord, SolvedState)>,
@@ -84,6 +85,10 @@ pub(crate) struct Snapshots<'a> {
     tolerance: f64,
     at_times: Vec<Option<(crate::history::StepRecord, SolvedState)>>,
     handovers: Vec<Handover>,
+    /// Which turning points are kept (`output.turning_point_fields`).
+    turning: TurningFields,
+    /// The last two turning points after phase 3 ([`TurningFields::FirstAndLast`]).
+    last: Vec<(crate::history::StepRecord, SolvedState)>,
 }
 
 impl crate::history::Observer for Snapshots<'_> {
@@ -92,7 +97,19 @@ impl crate::history::Observer for Snapshots<'_> {
             && prev.phase != record.phase
             && prev.phase > 0
         {
-            self.kept.push((prev, prev_state));
+            match self.turning {
+                TurningFields::All => self.kept.push((prev, prev_state)),
+                TurningFields::FirstAndLast if prev.phase <= 3 => {
+                    self.kept.push((prev, prev_state));
+                }
+                TurningFields::FirstAndLast => {
+                    if self.last.len() == 2 {
+                        self.last.remove(0);
+                    }
+                    self.last.push((prev, prev_state));
+                }
+                TurningFields::None => {}
+            }
         }
         self.previous = Some((record.clone(), state.to_owned()));
         // The last step at a snapshot time wins (a ramp to a non-zero first point is solved
@@ -183,6 +200,8 @@ pub fn solve(
         tolerance: scenario.time_tolerance,
         at_times: vec![None; scenario.snapshots.len()],
         handovers: Vec::new(),
+        turning: scenario.raw.output.turning_point_fields,
+        last: Vec::new(),
     };
     if let Some(history) = &scenario.history {
         match crate::history::run_history(
@@ -248,8 +267,9 @@ pub fn solve(
     };
     // Turning points and the last step, unless switched off.
     let mut turning_fields = Vec::new();
-    if scenario.raw.output.turning_point_fields {
-        for (rec, state) in snapshots.kept.iter().chain(snapshots.previous.iter()) {
+    if scenario.raw.output.turning_point_fields != TurningFields::None {
+        let kept = snapshots.kept.iter().chain(&snapshots.last);
+        for (rec, state) in kept.chain(snapshots.previous.iter()) {
             turning_fields.push(FieldSet {
                 stem: format!("step_{:05}", rec.step),
                 label: format!("step {}", rec.step),

@@ -45,10 +45,12 @@ pub struct RawOutput {
     /// `fields/t_<t>.csv` and plotted; strictly increasing, within the history's span.
     #[serde(default)]
     pub snapshots: Vec<f64>,
-    /// Also write `fields/step_NNNNN.csv` at every turning point and at the last step
-    /// (default true).
-    #[serde(default = "default_true")]
-    pub turning_point_fields: bool,
+    /// Which turning points of Q (and the last step) get a `fields/step_NNNNN.csv`:
+    /// `first_and_last` (the default: those of the first loading and the first cycle, the
+    /// last two, and the last step, so that a long run writes a few files), `all` (also
+    /// `true`) or `none` (also `false`).
+    #[serde(default)]
+    pub turning_point_fields: TurningFields,
     /// Sample points per field file (a multiple of 4 in [16, 100000], default 400).
     #[serde(default = "default_field_points")]
     pub field_points: usize,
@@ -56,6 +58,43 @@ pub struct RawOutput {
     /// loading; the default) or `si`.
     #[serde(default)]
     pub plot_units: PlotUnits,
+}
+
+/// Which turning points get field files (`output.turning_point_fields`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TurningFields {
+    /// The turning points of phases 1–3 (the first loading and the first cycle), the last two
+    /// turning points, and the last step.
+    #[default]
+    FirstAndLast,
+    /// Every turning point and the last step.
+    All,
+    /// None.
+    None,
+}
+
+impl<'de> Deserialize<'de> for TurningFields {
+    fn deserialize<D: serde::Deserializer<'de>>(de: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Given {
+            Flag(bool),
+            Word(String),
+        }
+        match Given::deserialize(de)? {
+            Given::Flag(true) => Ok(Self::All),
+            Given::Flag(false) => Ok(Self::None),
+            Given::Word(w) => match w.as_str() {
+                "first_and_last" => Ok(Self::FirstAndLast),
+                "all" => Ok(Self::All),
+                "none" => Ok(Self::None),
+                _ => Err(serde::de::Error::custom(format!(
+                    "`{w}` is not one of `first_and_last`, `all`, `none`, true, false"
+                ))),
+            },
+        }
+    }
 }
 
 /// Axes of the field plots.
@@ -73,15 +112,11 @@ impl Default for RawOutput {
     fn default() -> Self {
         Self {
             snapshots: Vec::new(),
-            turning_point_fields: true,
+            turning_point_fields: TurningFields::default(),
             field_points: default_field_points(),
             plot_units: PlotUnits::default(),
         }
     }
-}
-
-pub(super) fn default_true() -> bool {
-    true
 }
 
 pub(super) fn default_field_points() -> usize {

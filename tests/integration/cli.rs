@@ -205,6 +205,10 @@ fn assert_echoed(given: &serde_json::Value, echoed: &serde_json::Value, at: &str
                 assert_echoed(v, &echoed[i], &format!("{at}[{i}]"));
             }
         }
+        // The flag form of `turning_point_fields` is echoed as its word.
+        serde_json::Value::Bool(b) if at == ".output.turning_point_fields" => {
+            assert_eq!(echoed, if *b { "all" } else { "none" }, "{at}");
+        }
         other => assert_eq!(other, echoed, "{at}"),
     }
 }
@@ -292,9 +296,8 @@ fn run_checked(scenario: &Path) -> (tempfile::TempDir, PathBuf, Summary) {
                 assert!(index.contains(&format!("plots/{p}.svg")));
             }
             // Turning-point fields, unless switched off.
-            let turning = raw["output"]["turning_point_fields"]
-                .as_bool()
-                .unwrap_or(true);
+            let turning = raw["output"]["turning_point_fields"] != serde_json::json!(false)
+                && raw["output"]["turning_point_fields"] != serde_json::json!("none");
             let step_files = std::fs::read_dir(out.join("fields"))
                 .unwrap()
                 .filter(|e| {
@@ -659,8 +662,10 @@ fn default_run_reports_the_paper_baseline_and_the_interpenetration_warning() {
     let (header, steps) = read_csv(&out.join("steps.csv"));
     assert_eq!(header, STEPS_HEADER);
     assert_eq!(steps.len(), 131);
-    // Turning points (six reversals' last steps) and the last step.
-    for step in [10, 30, 50, 70, 90, 110, 130] {
+    // Turning points (six reversals' last steps) of the first cycle (phases 1–3) and the last
+    // two, and the last step.
+    assert_eq!(step_files(&out), [10, 30, 50, 90, 110, 130]);
+    for step in [10, 30, 50, 90, 110, 130] {
         let (header, _) = read_csv(&out.join(format!("fields/step_{step:05}.csv")));
         assert_eq!(header, FIELDS_HEADER);
     }
@@ -1187,5 +1192,68 @@ fn sweep_with_runs_reports_each_variants_history() {
         let amplitude: f64 = cells[col("delta_amplitude_last_cycle_m")].parse().unwrap();
         assert!((amplitude - 0.5 * (last[10] - last[11])).abs() <= 1e-9 * amplitude.abs());
         assert_eq!(*header.last().unwrap(), "error");
+    }
+}
+
+/// The step files a run writes, by step number.
+fn step_files(out: &Path) -> Vec<usize> {
+    let mut steps: Vec<usize> = std::fs::read_dir(out.join("fields"))
+        .unwrap()
+        .filter_map(|e| {
+            let name = e.unwrap().file_name().to_string_lossy().into_owned();
+            name.strip_prefix("step_")?
+                .strip_suffix(".csv")?
+                .parse()
+                .ok()
+        })
+        .collect();
+    steps.sort();
+    steps
+}
+
+/// By default a run writes the fields of the turning points of phases 1–3 (the first
+/// loading and the first cycle), of the last two turning points and of the last step, so
+/// that a long run writes a few files; `"all"` (or `true`) writes every turning point.
+#[test]
+fn turning_point_fields_are_first_and_last_by_default() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut raw: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(scenario_path("variable_amplitude")).unwrap(),
+    )
+    .unwrap();
+    raw["output"] = serde_json::json!({ "field_points": 16 });
+    let file = tmp.path().join("default.json");
+    std::fs::write(&file, raw.to_string()).unwrap();
+    let (_a, out, s) = run_checked(&file);
+    let h = s.history.unwrap();
+    // The turning points: the last step of each phase, then the last step.
+    let turning: Vec<usize> = h
+        .turning_points
+        .iter()
+        .map(|t| t["step"].as_u64().unwrap() as usize)
+        .collect();
+    let last = *turning.last().unwrap();
+    assert_eq!(last, h.steps);
+    let phases = h
+        .turning_points
+        .iter()
+        .map(|t| t["phase"].as_u64().unwrap());
+    let first: Vec<usize> = turning
+        .iter()
+        .zip(phases)
+        .filter(|(_, p)| *p <= 3)
+        .map(|(s, _)| *s)
+        .collect();
+    let n = turning.len();
+    assert!(n > 8, "a history with many reversals: {n}");
+    let mut expected = first.clone();
+    expected.extend(&turning[n - 3..]);
+    expected.dedup();
+    assert_eq!(step_files(&out), expected);
+    for all in [serde_json::json!("all"), serde_json::json!(true)] {
+        raw["output"] = serde_json::json!({ "field_points": 16, "turning_point_fields": all });
+        std::fs::write(&file, raw.to_string()).unwrap();
+        let (_b, out, _) = run_checked(&file);
+        assert_eq!(step_files(&out), turning);
     }
 }
