@@ -141,6 +141,13 @@ pub struct SolvedStep {
     trace: Option<Arc<OnceLock<(f64, StepIncrements)>>>,
 }
 
+impl SolvedStep {
+    /// The step's record without the increments.
+    pub fn record(&self) -> &StepRecord {
+        &self.record
+    }
+}
+
 /// The record of a hold step (nothing changes), passed to the observer.
 pub(super) fn hold_record(
     driver: &DriverState,

@@ -68,6 +68,10 @@ pub struct RunOptions {
     pub slip: SlipOptions,
     /// Which solver takes the steps.
     pub solver: SolverChoice,
+    /// Under [`SolverChoice::Auto`]: the general solver also takes the first step of every
+    /// phase, and the spectral solver's step is handed over when the two disagree
+    /// ([`super::continue_run`]).
+    pub check_phase_starts: bool,
 }
 
 impl RunOptions {
@@ -82,7 +86,11 @@ impl RunOptions {
             },
             _ => SlipOptions::default(),
         };
-        Self { slip, solver }
+        Self {
+            slip,
+            solver,
+            check_phase_starts: solver == SolverChoice::Auto,
+        }
     }
 }
 
@@ -92,6 +100,7 @@ impl RunOptions {
         Self {
             slip,
             solver: SolverChoice::Spectral,
+            check_phase_starts: false,
         }
     }
 }

@@ -15,7 +15,7 @@ use super::general::{GeneralRun, RunOptions, SolverChoice};
 use super::increments::{IncrementInputs, StepIncrements};
 use super::load::{LoadHistory, LoadPoint};
 use super::record::{Observer, StateView, StepFailure, StepRecord};
-use super::regime::Regime;
+use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
 
 /// A finished run: the records and the final driver state.
 #[derive(Debug, Clone)]
@@ -108,37 +108,56 @@ pub fn continue_run(
     let mut general =
         (options.solver == SolverChoice::General).then(|| GeneralRun::handover(model, driver));
     while next < points.len() {
-        let Some(run) = general.as_mut() else {
-            let (taken, failure) = spectral_stretch(
-                model,
-                disc,
-                driver,
-                &points[next..],
-                options.slip,
-                observer,
-                records,
-            )?;
-            next += taken;
-            if options.solver == SolverChoice::Spectral {
-                return Some(failure);
-            }
-            observer.on_handover(&failure);
-            general = Some(GeneralRun::handover(model, driver));
-            continue;
-        };
         let point = points[next];
-        let record = match run.step(model, point) {
+        let (run, step) = match general.take() {
+            Some(mut run) => {
+                let step = run.step(model, point);
+                (run, step)
+            }
+            None => {
+                let stop = spectral_stretch(
+                    model,
+                    disc,
+                    driver,
+                    &points[next..],
+                    options,
+                    observer,
+                    records,
+                )?;
+                next += stop.at;
+                if options.solver == SolverChoice::Spectral {
+                    return Some(stop.failure);
+                }
+                observer.on_handover(&stop.failure);
+                match stop.taken {
+                    Some((run, record)) => (run, Ok(record)),
+                    None => {
+                        let mut run = GeneralRun::handover(model, driver);
+                        let step = run.step(model, points[next]);
+                        (run, step)
+                    }
+                }
+            }
+        };
+        let record = match step {
             Ok(record) => record,
             Err(failure) => return Some(failure),
         };
         observer.on_step(&record, StateView::General(run.solver(), &run.state));
-        next += 1;
-        if options.solver == SolverChoice::Auto
-            && resumes(model, disc, driver, run, (point, &record), options.slip)
-        {
-            general = None;
-        }
+        let back = options.solver == SolverChoice::Auto
+            && resumes(
+                model,
+                disc,
+                driver,
+                &run,
+                (points[next], &record),
+                options.slip,
+            );
         records.push(record);
+        next += 1;
+        if !back {
+            general = Some(run);
+        }
     }
     None
 }
@@ -165,24 +184,7 @@ fn resumes(
         return false;
     };
     let spectral = record(point.step, point.t, &trial, last.regime, None);
-    if spectral.zones != last.zones || spectral.phase != last.phase {
-        return false;
-    }
-    let resolution = |x: f64| 2.0 * run.state.mesh.width_at(x);
-    let agree = |a: f64, b: f64| (a - b).abs() <= resolution(b);
-    let (lo, hi) = (
-        -last.eccentricity - last.half_width,
-        -last.eccentricity + last.half_width,
-    );
-    let (slo, shi) = (
-        -spectral.eccentricity - spectral.half_width,
-        -spectral.eccentricity + spectral.half_width,
-    );
-    if !(agree(slo, lo)
-        && agree(shi, hi)
-        && agree(spectral.stick_lo, last.stick_lo)
-        && agree(spectral.stick_hi, last.stick_hi))
-    {
+    if !agrees(run, last, &spectral) {
         return false;
     }
     trial.displacement = run.displacement();
@@ -192,9 +194,18 @@ fn resumes(
     true
 }
 
+/// Where the spectral solver stopped: the index of the step it did not take, why, and the
+/// general solver's run and record of that step if its check took it already.
+struct Stop {
+    at: usize,
+    failure: StepFailure,
+    taken: Option<(GeneralRun, StepRecord)>,
+}
+
 /// The spectral solver's steps from `driver` over `points`, pushing a record per step onto
-/// `records`; the index and failure of the first step it fails, if any (the driver is then at
-/// the last accepted step).
+/// `records`; where it stopped, if it did (the driver is then at the last accepted step).
+/// Under `check_phase_starts` the general solver takes the first step of each phase as well,
+/// and the step stops the stretch when the two disagree ([`contradicted`]).
 ///
 /// Pipelined on two threads: a step's increments (δ, dissipation, δn: a third of the work of
 /// a step) need only its two states, so they are computed on a worker thread while the next
@@ -209,10 +220,10 @@ fn spectral_stretch(
     disc: &Discretisation,
     driver: &mut DriverState,
     points: &[LoadPoint],
-    options: SlipOptions,
+    options: RunOptions,
     observer: &mut dyn Observer,
     records: &mut Vec<StepRecord>,
-) -> Option<(usize, StepFailure)> {
+) -> Option<Stop> {
     std::thread::scope(|scope| {
         let (jobs, inbox) = std::sync::mpsc::channel::<IncrementInputs>();
         let (outbox, results) = std::sync::mpsc::channel();
@@ -241,8 +252,24 @@ fn spectral_stretch(
         };
         let mut pending: Option<Box<SolvedStep>> = None;
         for (k, &point) in points.iter().enumerate() {
-            let solved = solve_step(model, disc, driver, point, options);
+            // The state before a step that begins a phase, kept for the general solver's check.
+            let before =
+                (options.check_phase_starts && begins_phase(model, driver, point)).then(|| {
+                    finish(pending.take(), driver, records, observer);
+                    driver.clone()
+                });
+            let solved = solve_step(model, disc, driver, point, options.slip);
             finish(pending.take(), driver, records, observer);
+            if let (Some(before), Ok(Solved::Slip(step))) = (before, &solved)
+                && let Some((failure, taken)) = contradicted(model, &before, point, step.record())
+            {
+                *driver = before;
+                return Some(Stop {
+                    at: k,
+                    failure,
+                    taken: Some(taken),
+                });
+            }
             match solved {
                 Ok(Solved::Hold(regime)) => {
                     records.push(hold_record(driver, point, regime, observer));
@@ -254,10 +281,75 @@ fn spectral_stretch(
                     }
                     pending = Some(solved);
                 }
-                Err(failure) => return Some((k, failure)),
+                Err(failure) => {
+                    return Some(Stop {
+                        at: k,
+                        failure,
+                        taken: None,
+                    });
+                }
             }
         }
         finish(pending.take(), driver, records, observer);
         None
     })
+}
+
+/// Whether the general solver's record of a step and the spectral solver's describe one state:
+/// the same zone structure and phase, and the contact and stick ends within two elements of
+/// the general solver's mesh there.
+fn agrees(run: &GeneralRun, general: &StepRecord, spectral: &StepRecord) -> bool {
+    if spectral.zones != general.zones || spectral.phase != general.phase {
+        return false;
+    }
+    let ends = |r: &StepRecord| {
+        let c = -r.eccentricity;
+        [c - r.half_width, c + r.half_width, r.stick_lo, r.stick_hi]
+    };
+    ends(general)
+        .iter()
+        .zip(ends(spectral))
+        .all(|(&g, s)| (g - s).abs() <= 2.0 * run.state.mesh.width_at(g))
+}
+
+/// Whether the step at `point` begins a phase from the driver's state.
+fn begins_phase(model: &ContactModel, driver: &DriverState, point: LoadPoint) -> bool {
+    let limit = model.friction * driver.state.normal_load;
+    let regime = next_regime(point.q - driver.state.tangential_load, 1e-12 * limit);
+    matches!(phase_event(driver.phase_sign, regime), PhaseEvent::Begin(_))
+}
+
+/// The general solver's check of the first step of a phase, which the spectral solver took
+/// from `before` with the record `spectral`: when the general solver finds another state (end
+/// layers the spectral form cannot hold), the reason to hand the step over and the general
+/// solver's run and record of it; `None` when it agrees or cannot take the step itself.
+fn contradicted(
+    model: &ContactModel,
+    before: &DriverState,
+    point: LoadPoint,
+    spectral: &StepRecord,
+) -> Option<(StepFailure, (GeneralRun, StepRecord))> {
+    let mut run = GeneralRun::handover(model, before);
+    let general = run.step(model, point).ok()?;
+    if agrees(&run, &general, spectral) {
+        return None;
+    }
+    let failure = StepFailure {
+        step: point.step,
+        t: point.t,
+        q: point.q,
+        regime: spectral.regime,
+        failure: crate::error::SolveFailure::NoAdmissibleState {
+            reason: format!(
+                "the general solver finds {} stick and {} slip zones ({} slip sign changes) \
+                 where the spectral solver's state has {} and {}",
+                general.zones.stick,
+                general.zones.slip,
+                general.zones.sign_changes,
+                spectral.zones.stick,
+                spectral.zones.slip
+            ),
+        },
+    };
+    Some((failure, (run, general)))
 }
