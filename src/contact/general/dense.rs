@@ -1,68 +1,265 @@
-//! A dense solve with row and column equilibration (the systems mix gap, potential and
-//! resultant rows whose scales differ by many orders of magnitude), factored once and reused.
+//! Cholesky factors of the element kernel `G = s·L` (symmetric positive definite for the scale
+//! `s < 0` the solver uses, module docs of [`super`]) on subsets of the elements. An active-set
+//! change of a few elements updates the factor by row insertions and deletions, O(m²) each,
+//! instead of a new factorization, O(m³); a larger change refactors.
 
-use faer::Mat;
-use faer::linalg::solvers::{PartialPivLu, Solve};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{
+    LltRegularization, cholesky_in_place, cholesky_in_place_scratch,
+};
+use faer::{Mat, MatMut, Par};
 
-/// `D_r A D_c = L U` with `D_r`, `D_c` scaling every row, then every column, to unit max-norm.
+/// The matrix `scale · log` over the whole mesh.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Kernel<'a> {
+    /// The Galerkin matrix of the logarithmic kernel (m²).
+    pub log: &'a Mat<f64>,
+    pub scale: f64,
+}
+
+impl Kernel<'_> {
+    fn at(&self, i: usize, j: usize) -> f64 {
+        self.scale * self.log[(i, j)]
+    }
+}
+
+/// The kernel is not positive definite on the set (the datum d is too small for the band).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct NotPositiveDefinite;
+
+/// `G_SS = R Rᵀ` for a set S of mesh elements, R lower triangular in the order of `set`.
 #[derive(Debug, Clone)]
-pub(super) struct Factored {
-    lu: PartialPivLu<f64>,
-    row: Vec<f64>,
-    col: Vec<f64>,
+pub(super) struct SubsetCholesky {
+    /// Mesh indices in factor order.
+    set: Vec<usize>,
+    /// Leading dimension of `r`: the number of mesh elements.
+    cap: usize,
+    /// R column-major (lower triangle only; the upper is not read).
+    r: Vec<f64>,
 }
 
-impl Factored {
-    /// Factor `a`; `None` if a row or column is zero.
-    pub fn new(mut a: Mat<f64>) -> Option<Self> {
-        let n = a.nrows();
-        debug_assert!(a.ncols() == n);
-        let mut row = vec![0.0; n];
-        for (i, r) in row.iter_mut().enumerate() {
-            let s = (0..n).map(|j| a[(i, j)].abs()).fold(0.0, f64::max);
-            if s == 0.0 {
-                return None;
-            }
-            *r = 1.0 / s;
-            for j in 0..n {
-                a[(i, j)] *= *r;
-            }
-        }
-        let mut col = vec![0.0; n];
-        for (j, c) in col.iter_mut().enumerate() {
-            let s = (0..n).map(|i| a[(i, j)].abs()).fold(0.0, f64::max);
-            if s == 0.0 {
-                return None;
-            }
-            *c = 1.0 / s;
-            for i in 0..n {
-                a[(i, j)] *= *c;
-            }
-        }
-        Some(Self {
-            lu: a.partial_piv_lu(),
-            row,
-            col,
-        })
+impl SubsetCholesky {
+    /// The factor of `kernel` on `set`.
+    pub fn new(kernel: Kernel, set: &[usize]) -> Result<Self, NotPositiveDefinite> {
+        let cap = kernel.log.nrows();
+        let mut f = Self {
+            set: Vec::new(),
+            cap,
+            r: vec![0.0; cap * cap],
+        };
+        f.refactor(kernel, set)?;
+        Ok(f)
     }
 
-    /// `A⁻¹ b`; `None` if not finite.
-    pub fn solve(&self, b: &[f64]) -> Option<Vec<f64>> {
-        let mut x: Vec<f64> = b.iter().zip(&self.row).map(|(b, r)| b * r).collect();
-        self.lu.solve_in_place(faer::ColMut::from_slice_mut(&mut x));
-        for (x, c) in x.iter_mut().zip(&self.col) {
-            *x *= c;
+    /// Make this the factor on `target` (distinct mesh indices), by updates if few elements
+    /// change, else by a new factorization.
+    pub fn update(&mut self, kernel: Kernel, target: &[usize]) -> Result<(), NotPositiveDefinite> {
+        let mut wanted = vec![false; self.cap];
+        for &i in target {
+            wanted[i] = true;
         }
-        x.iter().all(|x| x.is_finite()).then_some(x)
+        let mut present = vec![false; self.cap];
+        for &i in &self.set {
+            present[i] = true;
+        }
+        let remove: Vec<usize> = (0..self.set.len())
+            .filter(|&k| !wanted[self.set[k]])
+            .collect();
+        let add: Vec<usize> = target.iter().copied().filter(|&i| !present[i]).collect();
+        let changes = remove.len() + add.len();
+        if changes == 0 {
+            return Ok(());
+        }
+        // An insertion or deletion costs O(m²), a factorization O(m³/3) at a higher rate.
+        if changes > 4 + target.len() / 16 {
+            return self.refactor(kernel, target);
+        }
+        for &k in remove.iter().rev() {
+            self.delete(k);
+        }
+        for &j in &add {
+            if self.append(kernel, j).is_err() {
+                return self.refactor(kernel, target);
+            }
+        }
+        Ok(())
+    }
+
+    /// `x = G_SS⁻¹ b` on mesh-indexed vectors (entries outside S: ignored in `b`, zero in x).
+    pub fn solve(&self, b: &[f64]) -> Vec<f64> {
+        let mut y: Vec<f64> = self.set.iter().map(|&i| b[i]).collect();
+        self.solve_in_place(&mut y);
+        let mut x = vec![0.0; b.len()];
+        for (&i, v) in self.set.iter().zip(&y) {
+            x[i] = *v;
+        }
+        x
+    }
+
+    fn refactor(&mut self, kernel: Kernel, set: &[usize]) -> Result<(), NotPositiveDefinite> {
+        let (m, cap) = (set.len(), self.cap);
+        self.set.clear();
+        for (s, &j) in set.iter().enumerate() {
+            let col = kernel.log.col_as_slice(j);
+            let dst = &mut self.r[s * cap..s * cap + m];
+            for (d, &i) in dst.iter_mut().zip(set).skip(s) {
+                *d = kernel.scale * col[i];
+            }
+        }
+        if m > 0 {
+            let a = MatMut::from_column_major_slice_with_stride_mut(&mut self.r[..], m, m, cap);
+            let mut buf = MemBuffer::new(cholesky_in_place_scratch::<f64>(
+                m,
+                Par::Seq,
+                Default::default(),
+            ));
+            cholesky_in_place(
+                a,
+                LltRegularization::default(),
+                Par::Seq,
+                MemStack::new(&mut buf),
+                Default::default(),
+            )
+            .map_err(|_| NotPositiveDefinite)?;
+        }
+        self.set.extend_from_slice(set);
+        Ok(())
+    }
+
+    /// Append element `j` as the last row: `R y = G_Sj`, `ρ = √(G_jj − yᵀy)`.
+    fn append(&mut self, kernel: Kernel, j: usize) -> Result<(), NotPositiveDefinite> {
+        let (m, cap) = (self.set.len(), self.cap);
+        let col = kernel.log.col_as_slice(j);
+        let mut y: Vec<f64> = self.set.iter().map(|&i| kernel.scale * col[i]).collect();
+        self.forward(&mut y);
+        let d2 = kernel.at(j, j) - y.iter().map(|v| v * v).sum::<f64>();
+        if !(d2 > 0.0 && d2.is_finite()) {
+            return Err(NotPositiveDefinite);
+        }
+        for (s, v) in y.iter().enumerate() {
+            self.r[s * cap + m] = *v;
+        }
+        self.r[m * cap + m] = d2.sqrt();
+        self.set.push(j);
+        Ok(())
+    }
+
+    /// Delete the element in position `k`: the trailing block takes the rank-one update by
+    /// the deleted column below the diagonal (Givens form), then the row and column go.
+    fn delete(&mut self, k: usize) {
+        let (m, cap) = (self.set.len(), self.cap);
+        let mut v: Vec<f64> = self.r[k * cap + k + 1..k * cap + m].to_vec();
+        for (t, j) in (k + 1..m).enumerate() {
+            let col = &mut self.r[j * cap..j * cap + m];
+            let rjj = col[j];
+            let rho = rjj.hypot(v[t]);
+            let (c, s) = (rho / rjj, v[t] / rjj);
+            col[j] = rho;
+            for (x, vi) in col[j + 1..m].iter_mut().zip(&mut v[t + 1..]) {
+                *x = (*x + s * *vi) / c;
+                *vi = c * *vi - s * *x;
+            }
+        }
+        for j in 0..k {
+            self.r
+                .copy_within(j * cap + k + 1..j * cap + m, j * cap + k);
+        }
+        for j in k + 1..m {
+            self.r
+                .copy_within(j * cap + j..j * cap + m, (j - 1) * cap + j - 1);
+        }
+        self.set.remove(k);
+    }
+
+    /// `R y = b` in place (factor order).
+    fn forward(&self, b: &mut [f64]) {
+        let cap = self.cap;
+        let m = b.len();
+        for j in 0..m {
+            let col = &self.r[j * cap..j * cap + m];
+            let yj = b[j] / col[j];
+            b[j] = yj;
+            for (x, l) in b[j + 1..].iter_mut().zip(&col[j + 1..]) {
+                *x -= l * yj;
+            }
+        }
+    }
+
+    /// `R Rᵀ x = b` in place (factor order).
+    fn solve_in_place(&self, b: &mut [f64]) {
+        self.forward(b);
+        let cap = self.cap;
+        let m = b.len();
+        for j in (0..m).rev() {
+            let col = &self.r[j * cap..j * cap + m];
+            let s: f64 = col[j + 1..]
+                .iter()
+                .zip(&b[j + 1..])
+                .map(|(l, x)| l * x)
+                .sum();
+            b[j] = (b[j] - s) / col[j];
+        }
     }
 }
 
-/// Factorizations kept through the outer iterations of one step, keyed by the element sets
-/// that define the matrices.
+/// Factors kept through the outer iterations of one step.
 #[derive(Debug, Default)]
 pub(super) struct Workspace {
-    /// The normal system for a contact set.
-    pub normal: Option<(Vec<bool>, Factored)>,
-    /// The tangential step system for (contact elements, free elements).
-    pub tangential: Option<(Vec<usize>, Vec<usize>, Factored)>,
+    /// `−L/π` on the contact set.
+    pub normal: Option<SubsetCholesky>,
+    /// The tangential stiffness on the free set.
+    pub tangential: Option<SubsetCholesky>,
+}
+
+impl Workspace {
+    /// The factor in `slot`, brought to `set`.
+    pub fn factor<'w>(
+        slot: &'w mut Option<SubsetCholesky>,
+        kernel: Kernel,
+        set: &[usize],
+    ) -> Result<&'w SubsetCholesky, NotPositiveDefinite> {
+        match slot {
+            Some(f) => f.update(kernel, set)?,
+            None => *slot = Some(SubsetCholesky::new(kernel, set)?),
+        }
+        Ok(slot.as_ref().expect("set above"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::general::influence::Influence;
+    use crate::contact::general::mesh::Mesh;
+
+    /// Updates by insertion and deletion solve as a new factorization of the same set does.
+    #[test]
+    fn updated_factor_solves_like_a_new_one() {
+        let mesh = Mesh::uniform(-1.0, 1.0, 60);
+        let inf = Influence::new(&mesh, 10.0);
+        let kernel = Kernel {
+            log: &inf.log,
+            scale: -1.0 / std::f64::consts::PI,
+        };
+        let b: Vec<f64> = (0..60).map(|i| (i as f64 * 0.37).sin()).collect();
+        let mut f = SubsetCholesky::new(kernel, &(10..50).collect::<Vec<_>>()).unwrap();
+        for target in [
+            (8..49).collect::<Vec<_>>(),
+            (5..20).chain(22..52).collect(),
+            (5..19).chain(23..55).collect(),
+        ] {
+            f.update(kernel, &target).unwrap();
+            let x = f.solve(&b);
+            let fresh = SubsetCholesky::new(kernel, &target).unwrap().solve(&b);
+            let scale = fresh.iter().fold(0.0, |a: f64, v| a.max(v.abs()));
+            for (i, (u, v)) in x.iter().zip(&fresh).enumerate() {
+                assert!((u - v).abs() < 1e-10 * scale, "{i}: {u} vs {v}");
+            }
+            // The residual of G_SS x = b on the set.
+            for &i in &target {
+                let r: f64 = target.iter().map(|&j| kernel.at(i, j) * x[j]).sum::<f64>() - b[i];
+                assert!(r.abs() < 1e-12 * scale, "{r}");
+            }
+        }
+    }
 }

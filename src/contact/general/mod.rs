@@ -562,6 +562,10 @@ impl Solver {
             bound: &bound,
             total,
             elements: &act,
+            kernel: dense::Kernel {
+                log: &self.influence.log,
+                scale: -c.y11 / PI,
+            },
         };
         let m = tangential::minimise(&programme, &begin, &begin_status, work)?;
         for (r, &i) in act.iter().enumerate() {

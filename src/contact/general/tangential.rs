@@ -4,8 +4,9 @@
 
 use faer::Mat;
 
-use super::dense::{Factored, Workspace};
+use super::dense::{Kernel, Workspace};
 use super::influence::dot;
+use super::normal::not_definite;
 
 use crate::error::SolveFailure;
 
@@ -22,8 +23,11 @@ pub(super) struct Programme<'a> {
     pub bound: &'a [f64],
     /// Q (N/m).
     pub total: f64,
-    /// The mesh indices of the contact elements (the key of the cached factorizations).
+    /// The mesh indices of the contact elements.
     pub elements: &'a [usize],
+    /// `K` over the whole mesh (`K = kernel` on `elements`), for the factors of its free
+    /// blocks, which are kept by mesh index through the changes of the contact set.
+    pub kernel: Kernel<'a>,
 }
 
 /// Status of one element in the working set.
@@ -96,38 +100,37 @@ fn status_of(q: &[f64], bound: &[f64]) -> Vec<Bound> {
         .collect()
 }
 
-/// The equality-constrained step on the free set: `[K_FF −w_F; w_Fᵀ 0](d; λ) = (−∇_F; 0)`.
+/// The equality-constrained step on the free set: `[K_FF −w_F; w_Fᵀ 0](d; λ) = (−∇_F; 0)`,
+/// by the factor of `K_FF`: `d = λ K_FF⁻¹w_F − K_FF⁻¹∇_F` with
+/// `λ = w_Fᵀ K_FF⁻¹∇_F / w_Fᵀ K_FF⁻¹w_F`.
 fn free_step(
     p: &Programme,
     free: &[usize],
     grad: &[f64],
     work: &mut Workspace,
 ) -> Result<(Vec<f64>, f64), SolveFailure> {
-    let m = free.len();
-    let cached = matches!(&work.tangential, Some((e, f, _)) if e.as_slice() == p.elements && f.as_slice() == free);
-    if !cached {
-        let mut a = Mat::<f64>::zeros(m + 1, m + 1);
-        for (r, &i) in free.iter().enumerate() {
-            for (s, &j) in free.iter().enumerate() {
-                a[(r, s)] = p.k[(i, j)];
-            }
-            a[(r, m)] = -p.w[i];
-            a[(m, r)] = p.w[i];
-        }
-        let f = Factored::new(a).ok_or(SolveFailure::NonFinite {
-            field: "tangential step matrix",
-        })?;
-        work.tangential = Some((p.elements.to_vec(), free.to_vec(), f));
+    let set: Vec<usize> = free.iter().map(|&r| p.elements[r]).collect();
+    let factor = Workspace::factor(&mut work.tangential, p.kernel, &set).map_err(not_definite)?;
+    let size = p.kernel.log.nrows();
+    let mut b = vec![0.0; size];
+    let mut w = vec![0.0; size];
+    for (&r, &i) in free.iter().zip(&set) {
+        b[i] = grad[r];
+        w[i] = p.w[r];
     }
-    let mut b = vec![0.0; m + 1];
-    for (r, &i) in free.iter().enumerate() {
-        b[r] = -grad[i];
+    let kg = factor.solve(&b);
+    let kw = factor.solve(&w);
+    let (wkg, wkw) = set.iter().fold((0.0, 0.0), |(a, b), &i| {
+        (a + w[i] * kg[i], b + w[i] * kw[i])
+    });
+    let shift = wkg / wkw;
+    let d: Vec<f64> = set.iter().map(|&i| shift * kw[i] - kg[i]).collect();
+    if !(shift.is_finite() && d.iter().all(|x| x.is_finite())) {
+        return Err(SolveFailure::NonFinite {
+            field: "tangential step",
+        });
     }
-    let factored = &work.tangential.as_ref().expect("factored above").2;
-    let x = factored.solve(&b).ok_or(SolveFailure::NonFinite {
-        field: "tangential step",
-    })?;
-    Ok((x[..m].to_vec(), x[m]))
+    Ok((d, shift))
 }
 
 /// The minimiser, started from the working set `start` (the previous solution's): first by
@@ -375,6 +378,10 @@ mod tests {
             bound: &bound,
             total: 0.1,
             elements: &elements,
+            kernel: Kernel {
+                log: &inf.log,
+                scale: -1.0 / std::f64::consts::PI,
+            },
         };
         let tol = 1e-12;
         let a = primal(&p, &vec![0.0; n], tol, &mut Workspace::default()).unwrap();
