@@ -7,7 +7,10 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{
     LltRegularization, cholesky_in_place, cholesky_in_place_scratch,
 };
-use faer::{Mat, MatMut, Par};
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::{ColMut, Mat, MatMut, MatRef, Par};
 
 /// The matrix `scale · log` over the whole mesh.
 #[derive(Debug, Clone, Copy)]
@@ -85,15 +88,29 @@ impl SubsetCholesky {
         Ok(())
     }
 
-    /// `x = G_SS⁻¹ b` on mesh-indexed vectors (entries outside S: ignored in `b`, zero in x).
-    pub fn solve(&self, b: &[f64]) -> Vec<f64> {
-        let mut y: Vec<f64> = self.set.iter().map(|&i| b[i]).collect();
-        self.solve_in_place(&mut y);
-        let mut x = vec![0.0; b.len()];
-        for (&i, v) in self.set.iter().zip(&y) {
-            x[i] = *v;
+    /// `x = G_SS⁻¹ b` for each `b`, on mesh-indexed vectors (entries outside S: ignored in
+    /// `b`, zero in x).
+    pub fn solve<const K: usize>(&self, b: [&[f64]; K]) -> [Vec<f64>; K] {
+        let m = self.set.len();
+        let mut y = Mat::<f64>::from_fn(m, K, |r, k| b[k][self.set[r]]);
+        if m > 0 {
+            let r = self.factor();
+            solve_lower_triangular_in_place(r, y.as_mut(), Par::Seq);
+            solve_upper_triangular_in_place(r.transpose(), y.as_mut(), Par::Seq);
         }
-        x
+        std::array::from_fn(|k| {
+            let mut x = vec![0.0; b[k].len()];
+            for (r, &i) in self.set.iter().enumerate() {
+                x[i] = y[(r, k)];
+            }
+            x
+        })
+    }
+
+    /// R (its lower triangle).
+    fn factor(&self) -> MatRef<'_, f64> {
+        let m = self.set.len();
+        MatRef::from_column_major_slice_with_stride(&self.r[..], m, m, self.cap)
     }
 
     fn refactor(&mut self, kernel: Kernel, set: &[usize]) -> Result<(), NotPositiveDefinite> {
@@ -131,7 +148,13 @@ impl SubsetCholesky {
         let (m, cap) = (self.set.len(), self.cap);
         let col = kernel.log.col_as_slice(j);
         let mut y: Vec<f64> = self.set.iter().map(|&i| kernel.scale * col[i]).collect();
-        self.forward(&mut y);
+        if m > 0 {
+            solve_lower_triangular_in_place(
+                self.factor(),
+                ColMut::from_slice_mut(&mut y).as_mat_mut(),
+                Par::Seq,
+            );
+        }
         let d2 = kernel.at(j, j) - y.iter().map(|v| v * v).sum::<f64>();
         if !(d2 > 0.0 && d2.is_finite()) {
             return Err(NotPositiveDefinite);
@@ -169,36 +192,6 @@ impl SubsetCholesky {
                 .copy_within(j * cap + j..j * cap + m, (j - 1) * cap + j - 1);
         }
         self.set.remove(k);
-    }
-
-    /// `R y = b` in place (factor order).
-    fn forward(&self, b: &mut [f64]) {
-        let cap = self.cap;
-        let m = b.len();
-        for j in 0..m {
-            let col = &self.r[j * cap..j * cap + m];
-            let yj = b[j] / col[j];
-            b[j] = yj;
-            for (x, l) in b[j + 1..].iter_mut().zip(&col[j + 1..]) {
-                *x -= l * yj;
-            }
-        }
-    }
-
-    /// `R Rᵀ x = b` in place (factor order).
-    fn solve_in_place(&self, b: &mut [f64]) {
-        self.forward(b);
-        let cap = self.cap;
-        let m = b.len();
-        for j in (0..m).rev() {
-            let col = &self.r[j * cap..j * cap + m];
-            let s: f64 = col[j + 1..]
-                .iter()
-                .zip(&b[j + 1..])
-                .map(|(l, x)| l * x)
-                .sum();
-            b[j] = (b[j] - s) / col[j];
-        }
     }
 }
 
@@ -249,8 +242,8 @@ mod tests {
             (5..19).chain(23..55).collect(),
         ] {
             f.update(kernel, &target).unwrap();
-            let x = f.solve(&b);
-            let fresh = SubsetCholesky::new(kernel, &target).unwrap().solve(&b);
+            let [x] = f.solve([&b]);
+            let [fresh] = SubsetCholesky::new(kernel, &target).unwrap().solve([&b]);
             let scale = fresh.iter().fold(0.0, |a: f64, v| a.max(v.abs()));
             for (i, (u, v)) in x.iter().zip(&fresh).enumerate() {
                 assert!((u - v).abs() < 1e-10 * scale, "{i}: {u} vs {v}");

@@ -163,15 +163,13 @@ fn solve_on(
         }
     }
     let on_c = |a: &[f64], b: &[f64]| act.iter().map(|&i| a[i] * b[i]).sum::<f64>();
-    let u = factor.solve(&b1);
-    let e = factor.solve(&w);
+    let [u, e, v] = factor.solve([&b1, &w, &b2]);
     let (wu, we) = (on_c(&w, &u), on_c(&w, &e));
     let load = input.normal_load;
     let mut pressure = vec![0.0; n];
     let mut charge = vec![0.0; n];
     let (approach, potential) = match (input.electric, c.electric.is_some()) {
         (ElectricControl::Charge(gamma), true) => {
-            let v = factor.solve(&b2);
             let wv = on_c(&w, &v);
             let dz = (c.y22 * load + y23 * gamma - wu) / we;
             let phi = (y23 * load + y33 * gamma - wv) / we;
@@ -187,7 +185,6 @@ fn solve_on(
         }
         (ElectricControl::Potential(phi), true) => {
             // Eliminating g: (y22 − y23²/y33) G p = b₁ − (y23/y33) b₂ + w δz.
-            let v = factor.solve(&b2);
             let wv = on_c(&w, &v);
             let ratio = y23 / y33;
             let ystar = c.y22 - y23 * ratio;

@@ -5,7 +5,7 @@
 use faer::Mat;
 
 use super::dense::{Kernel, Workspace};
-use super::influence::dot;
+use super::influence::mat_vec;
 use super::normal::not_definite;
 
 use crate::error::SolveFailure;
@@ -118,8 +118,7 @@ fn free_step(
         b[i] = grad[r];
         w[i] = p.w[r];
     }
-    let kg = factor.solve(&b);
-    let kw = factor.solve(&w);
+    let [kg, kw] = factor.solve([&b, &w]);
     let (wkg, wkw) = set.iter().fold((0.0, 0.0), |(a, b), &i| {
         (a + w[i] * kg[i], b + w[i] * kw[i])
     });
@@ -188,23 +187,17 @@ fn primal_dual(
             .collect();
         // Make the equality hold through the free elements: Q − (bound part) on them.
         let bound_part: f64 = q.iter().zip(p.w).map(|(q, w)| q * w).sum();
-        let mut grad: Vec<f64> = (0..n)
-            .map(|i| dot(p.k.col_as_slice(i), &q) + p.c[i])
-            .collect();
         let wf: f64 = free.iter().map(|&i| p.w[i] * p.w[i]).sum();
         // A particular free traction meeting the equality, then the free step from it.
         let t = (p.total - bound_part) / wf;
         for &i in &free {
             q[i] = t * p.w[i];
         }
-        for &i in &free {
-            axpy(&mut grad, t * p.w[i], p.k.col_as_slice(i));
-        }
-        let (d, shift) = free_step(p, &free, &grad, work)?;
+        let (d, shift) = free_step(p, &free, &gradient(p, &q), work)?;
         for (k, &i) in free.iter().enumerate() {
             q[i] += d[k];
-            axpy(&mut grad, d[k], p.k.col_as_slice(i));
         }
+        let grad = gradient(p, &q);
         let slip: Vec<f64> = (0..n)
             .map(|i| match status[i] {
                 Bound::Free => 0.0,
@@ -253,9 +246,7 @@ fn primal(
     let mut status = status_of(&q, p.bound);
     let limit = 20 * n + 20;
     for iteration in 1..=limit {
-        let mut grad: Vec<f64> = (0..n)
-            .map(|i| dot(p.k.col_as_slice(i), &q) + p.c[i])
-            .collect();
+        let mut grad = gradient(p, &q);
         let free: Vec<usize> = (0..n).filter(|&i| status[i] == Bound::Free).collect();
         let shift = if free.is_empty() {
             shift_without_free(p, &grad, &status)
@@ -278,13 +269,13 @@ fn primal(
             }
             for (k, &i) in free.iter().enumerate() {
                 q[i] += alpha * d[k];
-                axpy(&mut grad, alpha * d[k], p.k.col_as_slice(i));
             }
             if let Some((i, up)) = blocking {
                 q[i] = if up { p.bound[i] } else { -p.bound[i] };
                 status[i] = if up { Bound::Upper } else { Bound::Lower };
                 continue;
             }
+            grad = gradient(p, &q);
             shift
         };
         let slip: Vec<f64> = (0..n)
@@ -344,11 +335,14 @@ fn shift_without_free(p: &Programme, grad: &[f64], status: &[Bound]) -> f64 {
     }
 }
 
-/// `y += a x`.
-fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
-    for (y, x) in y.iter_mut().zip(x) {
-        *y += a * x;
+/// `∇J = K q + c`.
+fn gradient(p: &Programme, q: &[f64]) -> Vec<f64> {
+    let mut grad = vec![0.0; q.len()];
+    mat_vec(p.k, q, &mut grad);
+    for (g, c) in grad.iter_mut().zip(p.c) {
+        *g += c;
     }
+    grad
 }
 
 #[cfg(test)]
