@@ -1,16 +1,20 @@
 //! Cholesky factors of the element kernel `G = s·L` (symmetric positive definite for the scale
-//! `s < 0` the solver uses, module docs of [`super`]) on subsets of the elements. An active-set
-//! change of a few elements updates the factor by row insertions and deletions, O(m²) each,
-//! instead of a new factorization, O(m³); a larger change refactors.
+//! `s < 0` the solver uses, module docs of [`super`]) on subsets of the elements, kept through
+//! the active-set changes of a step. The factor's order puts the elements far from the middle
+//! of the set last, so that the elements an active set changes (at the ends of the contact or
+//! of a stick zone) sit in its trailing rows: a change keeps the leading block up to the first
+//! element that leaves and appends the rest as one block (a triangular solve, a rank-t
+//! product and a t×t factorization), instead of factoring the whole set again.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{
     LltRegularization, cholesky_in_place, cholesky_in_place_scratch,
 };
+use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
-use faer::{ColMut, Mat, MatMut, MatRef, Par};
+use faer::{Accum, Mat, MatRef, Par};
 
 /// The matrix `scale · log` over the whole mesh.
 #[derive(Debug, Clone, Copy)]
@@ -50,42 +54,36 @@ impl SubsetCholesky {
             cap,
             r: vec![0.0; cap * cap],
         };
-        f.refactor(kernel, set)?;
+        f.update(kernel, set)?;
         Ok(f)
     }
 
-    /// Make this the factor on `target` (distinct mesh indices), by updates if few elements
-    /// change, else by a new factorization.
+    /// Make this the factor on `target` (distinct mesh indices): keep the leading block up to
+    /// the first element not in `target`, then append the other elements of `target`, those
+    /// nearest the middle of `target` (by mesh index) first.
     pub fn update(&mut self, kernel: Kernel, target: &[usize]) -> Result<(), NotPositiveDefinite> {
         let mut wanted = vec![false; self.cap];
         for &i in target {
             wanted[i] = true;
         }
-        let mut present = vec![false; self.cap];
-        for &i in &self.set {
-            present[i] = true;
-        }
-        let remove: Vec<usize> = (0..self.set.len())
-            .filter(|&k| !wanted[self.set[k]])
-            .collect();
-        let add: Vec<usize> = target.iter().copied().filter(|&i| !present[i]).collect();
-        let changes = remove.len() + add.len();
-        if changes == 0 {
+        let keep = self
+            .set
+            .iter()
+            .position(|&i| !wanted[i])
+            .unwrap_or(self.set.len());
+        if keep == self.set.len() && keep == target.len() {
             return Ok(());
         }
-        // An insertion or deletion costs O(m²), a factorization O(m³/3) at a higher rate.
-        if changes > 4 + target.len() / 16 {
-            return self.refactor(kernel, target);
+        self.set.truncate(keep);
+        for &i in &self.set {
+            wanted[i] = false;
         }
-        for &k in remove.iter().rev() {
-            self.delete(k);
-        }
-        for &j in &add {
-            if self.append(kernel, j).is_err() {
-                return self.refactor(kernel, target);
-            }
-        }
-        Ok(())
+        let mut rest: Vec<usize> = target.iter().copied().filter(|&i| wanted[i]).collect();
+        let (lo, hi) = target
+            .iter()
+            .fold((usize::MAX, 0), |(lo, hi), &i| (lo.min(i), hi.max(i)));
+        rest.sort_by_key(|&i| (2 * i).abs_diff(lo + hi));
+        self.append(kernel, &rest).inspect_err(|_| self.set.clear())
     }
 
     /// `x = G_SS⁻¹ b` for each `b`, on mesh-indexed vectors (entries outside S: ignored in
@@ -94,7 +92,7 @@ impl SubsetCholesky {
         let m = self.set.len();
         let mut y = Mat::<f64>::from_fn(m, K, |r, k| b[k][self.set[r]]);
         if m > 0 {
-            let r = self.factor();
+            let r = self.block(0, m);
             solve_lower_triangular_in_place(r, y.as_mut(), Par::Seq);
             solve_upper_triangular_in_place(r.transpose(), y.as_mut(), Par::Seq);
         }
@@ -107,91 +105,62 @@ impl SubsetCholesky {
         })
     }
 
-    /// R (its lower triangle).
-    fn factor(&self) -> MatRef<'_, f64> {
-        let m = self.set.len();
-        MatRef::from_column_major_slice_with_stride(&self.r[..], m, m, self.cap)
+    /// The diagonal block of R from row and column `at`, of size `size`.
+    fn block(&self, at: usize, size: usize) -> MatRef<'_, f64> {
+        MatRef::from_column_major_slice_with_stride(
+            &self.r[at * (self.cap + 1)..],
+            size,
+            size,
+            self.cap,
+        )
     }
 
-    fn refactor(&mut self, kernel: Kernel, set: &[usize]) -> Result<(), NotPositiveDefinite> {
-        let (m, cap) = (set.len(), self.cap);
-        self.set.clear();
-        for (s, &j) in set.iter().enumerate() {
-            let col = kernel.log.col_as_slice(j);
-            let dst = &mut self.r[s * cap..s * cap + m];
-            for (d, &i) in dst.iter_mut().zip(set).skip(s) {
-                *d = kernel.scale * col[i];
-            }
+    /// Append the elements `add` as a block: with R₁₁ the current factor,
+    /// `R₂₁ = G₂₁ R₁₁⁻ᵀ` and `R₂₂ R₂₂ᵀ = G₂₂ − R₂₁ R₂₁ᵀ`.
+    fn append(&mut self, kernel: Kernel, add: &[usize]) -> Result<(), NotPositiveDefinite> {
+        let (m, t, cap) = (self.set.len(), add.len(), self.cap);
+        if t == 0 {
+            return Ok(());
         }
+        // X = R₁₁⁻¹ G₁₂ = R₂₁ᵀ.
+        let mut x = Mat::<f64>::from_fn(m, t, |r, k| kernel.at(self.set[r], add[k]));
+        let mut c = Mat::<f64>::from_fn(t, t, |r, k| kernel.at(add[r], add[k]));
         if m > 0 {
-            let a = MatMut::from_column_major_slice_with_stride_mut(&mut self.r[..], m, m, cap);
-            let mut buf = MemBuffer::new(cholesky_in_place_scratch::<f64>(
-                m,
-                Par::Seq,
-                Default::default(),
-            ));
-            cholesky_in_place(
-                a,
-                LltRegularization::default(),
-                Par::Seq,
-                MemStack::new(&mut buf),
-                Default::default(),
-            )
-            .map_err(|_| NotPositiveDefinite)?;
-        }
-        self.set.extend_from_slice(set);
-        Ok(())
-    }
-
-    /// Append element `j` as the last row: `R y = G_Sj`, `ρ = √(G_jj − yᵀy)`.
-    fn append(&mut self, kernel: Kernel, j: usize) -> Result<(), NotPositiveDefinite> {
-        let (m, cap) = (self.set.len(), self.cap);
-        let col = kernel.log.col_as_slice(j);
-        let mut y: Vec<f64> = self.set.iter().map(|&i| kernel.scale * col[i]).collect();
-        if m > 0 {
-            solve_lower_triangular_in_place(
-                self.factor(),
-                ColMut::from_slice_mut(&mut y).as_mat_mut(),
+            solve_lower_triangular_in_place(self.block(0, m), x.as_mut(), Par::Seq);
+            matmul(
+                c.as_mut(),
+                Accum::Add,
+                x.transpose(),
+                x.as_ref(),
+                -1.0,
                 Par::Seq,
             );
         }
-        let d2 = kernel.at(j, j) - y.iter().map(|v| v * v).sum::<f64>();
-        if !(d2 > 0.0 && d2.is_finite()) {
-            return Err(NotPositiveDefinite);
-        }
-        for (s, v) in y.iter().enumerate() {
-            self.r[s * cap + m] = *v;
-        }
-        self.r[m * cap + m] = d2.sqrt();
-        self.set.push(j);
-        Ok(())
-    }
-
-    /// Delete the element in position `k`: the trailing block takes the rank-one update by
-    /// the deleted column below the diagonal (Givens form), then the row and column go.
-    fn delete(&mut self, k: usize) {
-        let (m, cap) = (self.set.len(), self.cap);
-        let mut v: Vec<f64> = self.r[k * cap + k + 1..k * cap + m].to_vec();
-        for (t, j) in (k + 1..m).enumerate() {
-            let col = &mut self.r[j * cap..j * cap + m];
-            let rjj = col[j];
-            let rho = rjj.hypot(v[t]);
-            let (c, s) = (rho / rjj, v[t] / rjj);
-            col[j] = rho;
-            for (x, vi) in col[j + 1..m].iter_mut().zip(&mut v[t + 1..]) {
-                *x = (*x + s * *vi) / c;
-                *vi = c * *vi - s * *x;
+        let mut buf = MemBuffer::new(cholesky_in_place_scratch::<f64>(
+            t,
+            Par::Seq,
+            Default::default(),
+        ));
+        cholesky_in_place(
+            c.as_mut(),
+            LltRegularization::default(),
+            Par::Seq,
+            MemStack::new(&mut buf),
+            Default::default(),
+        )
+        .map_err(|_| NotPositiveDefinite)?;
+        for b in 0..m {
+            let col = &mut self.r[b * cap + m..b * cap + m + t];
+            for (a, v) in col.iter_mut().enumerate() {
+                *v = x[(b, a)];
             }
         }
-        for j in 0..k {
-            self.r
-                .copy_within(j * cap + k + 1..j * cap + m, j * cap + k);
+        for b in 0..t {
+            let col = &mut self.r[(m + b) * cap + m..(m + b) * cap + m + t];
+            col[b..].copy_from_slice(&c.col_as_slice(b)[b..]);
         }
-        for j in k + 1..m {
-            self.r
-                .copy_within(j * cap + j..j * cap + m, (j - 1) * cap + j - 1);
-        }
-        self.set.remove(k);
+        self.set.extend_from_slice(add);
+        Ok(())
     }
 }
 
