@@ -171,6 +171,8 @@ pub(super) struct Workspace {
     pub normal: Option<SubsetCholesky>,
     /// The tangential stiffness on the free set.
     pub tangential: Option<SubsetCholesky>,
+    /// The tangential stiffness K on the contact set (its mesh indices, K).
+    pub stiffness: Option<(Vec<usize>, Mat<f64>)>,
 }
 
 impl Workspace {

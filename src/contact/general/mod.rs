@@ -526,9 +526,13 @@ impl Solver {
             return Ok((q, out));
         }
         let fixed = self.fixed_displacement(&normal.pressure, &normal.charge);
-        let k = Mat::<f64>::from_fn(act.len(), act.len(), |r, s| {
-            -(c.y11 / PI) * self.influence.log[(act[r], act[s])]
-        });
+        // K on the contact elements, kept while the contact set stays.
+        let k = match work.stiffness.take() {
+            Some((set, k)) if set == act => k,
+            _ => Mat::<f64>::from_fn(act.len(), act.len(), |r, s| {
+                -(c.y11 / PI) * self.influence.log[(act[r], act[s])]
+            }),
+        };
         let w: Vec<f64> = act.iter().map(|&i| self.mesh.width(i)).collect();
         let lin: Vec<f64> = act
             .iter()
@@ -568,6 +572,7 @@ impl Solver {
             },
         };
         let m = tangential::minimise(&programme, &begin, &begin_status, work)?;
+        work.stiffness = Some((act.clone(), k));
         for (r, &i) in act.iter().enumerate() {
             q[i] = m.q[r];
             out.slip[i] = m.slip[r];
