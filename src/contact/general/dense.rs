@@ -196,7 +196,8 @@ mod tests {
     use crate::contact::general::influence::Influence;
     use crate::contact::general::mesh::Mesh;
 
-    /// Updates by insertion and deletion solve as a new factorization of the same set does.
+    /// Updated factors (elements leaving inside and at the end of the order, elements
+    /// entering) solve as a new factorization of the same set does.
     #[test]
     fn updated_factor_solves_like_a_new_one() {
         let mesh = Mesh::uniform(-1.0, 1.0, 60);

@@ -1,6 +1,8 @@
 //! The tangential subproblem at fixed pressure and charge (module docs of [`super`]): a
-//! strictly convex quadratic programme with box constraints and one equality, solved by a
-//! primal active-set method (Nocedal & Wright, *Numerical Optimization*, Algorithm 16.3).
+//! strictly convex quadratic programme with box constraints and one equality, solved by the
+//! primal–dual active-set method (Hintermüller, Ito & Kunisch 2003) and, if that does not
+//! settle, by the primal active-set method (Nocedal & Wright, *Numerical Optimization*,
+//! Algorithm 16.3).
 
 use faer::Mat;
 
