@@ -1,7 +1,7 @@
 //! Element integrals of the surface response (module docs of [`super`]): the Galerkin
 //! matrices of the logarithmic and sign kernels for piecewise-constant densities.
 
-use faer::Mat;
+use faer::{Accum, ColMut, ColRef, Mat, Par};
 
 use super::mesh::Mesh;
 
@@ -57,11 +57,9 @@ impl Influence {
         Self { log, widths: w }
     }
 
-    /// `out = log · v` (by columns: the matrix is symmetric).
+    /// `out = log · v`.
     pub fn log_apply(&self, v: &[f64], out: &mut [f64]) {
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = dot(self.log.col_as_slice(i), v);
-        }
+        mat_vec(&self.log, v, out);
     }
 
     /// `out = sign · v`: `out_i = w_i (Σ_{j<i} w_j v_j − Σ_{j>i} w_j v_j)`.
@@ -74,6 +72,18 @@ impl Influence {
             below += own;
         }
     }
+}
+
+/// `out = a v` for a square matrix `a`.
+pub(super) fn mat_vec(a: &Mat<f64>, v: &[f64], out: &mut [f64]) {
+    faer::linalg::matmul::matmul(
+        ColMut::from_slice_mut(out).as_mat_mut(),
+        Accum::Replace,
+        a.as_ref(),
+        ColRef::from_slice(v).as_mat(),
+        1.0,
+        Par::Seq,
+    );
 }
 
 /// `Σ a_i b_i`.

@@ -84,8 +84,18 @@
 //! coupling), the two subproblems alternate until p and q change by less than
 //! [`Options::tolerance`] (relative to max p and η max p). After [`Options::freeze_after`]
 //! outer iterations elements may leave the contact but not enter it, so that an element at a
-//! contact end cannot cycle between states. Matrix factorizations are reused while the element
-//! sets that define them are unchanged.
+//! contact end cannot cycle between states.
+//!
+//! # Linear algebra
+//! Both subproblems reduce to solves with `G = −L/π` on a set of elements: with
+//! `Y = [y22 y23; y23 y33]` the normal and electric rows on C read `(Y ⊗ G_CC)(p; g) =
+//! (b₁ + w δz; b₂ + w φ0)`, so `u = G⁻¹b₁`, `v = G⁻¹b₂` and `e = G⁻¹w` give δz and φ0 from the
+//! resultant rows and then p and g in closed form; the tangential step on the free set F is
+//! `d = λ K_FF⁻¹w_F − K_FF⁻¹∇_F`, `K = y11 G`, with λ from `w_Fᵀd = 0`. Each set has a
+//! Cholesky factor (G is symmetric positive definite when d exceeds the band's logarithmic
+//! capacity, as above), kept through the step's active-set changes: ordered with the
+//! elements far from the middle of the set last, a change at the ends of the contact or of a
+//! stick zone keeps the leading block and refactors only the trailing rows (`dense`).
 //!
 //! # Resolution
 //! Contact and stick-zone ends lie within one element (a stick run ends at an element edge;
@@ -317,7 +327,8 @@ impl GeneralState {
 
 impl Solver {
     /// A solver for a model on a mesh. The datum d should exceed a quarter of the mesh's
-    /// length, so that the tangential programme is strictly convex (module docs).
+    /// length, so that `−L` is positive definite: the tangential programme is strictly convex
+    /// and the Cholesky factors of the subproblems exist (module docs).
     pub fn new(model: &ContactModel, mesh: Mesh, options: Options) -> Self {
         let c = &model.compliance;
         let electric = match model.electrode {
@@ -527,9 +538,13 @@ impl Solver {
             return Ok((q, out));
         }
         let fixed = self.fixed_displacement(&normal.pressure, &normal.charge);
-        let k = Mat::<f64>::from_fn(act.len(), act.len(), |r, s| {
-            -(c.y11 / PI) * self.influence.log[(act[r], act[s])]
-        });
+        // K on the contact elements, kept while the contact set stays.
+        let k = match work.stiffness.take() {
+            Some((set, k)) if set == act => k,
+            _ => Mat::<f64>::from_fn(act.len(), act.len(), |r, s| {
+                -(c.y11 / PI) * self.influence.log[(act[r], act[s])]
+            }),
+        };
         let w: Vec<f64> = act.iter().map(|&i| self.mesh.width(i)).collect();
         let lin: Vec<f64> = act
             .iter()
@@ -563,8 +578,13 @@ impl Solver {
             bound: &bound,
             total,
             elements: &act,
+            kernel: dense::Kernel {
+                log: &self.influence.log,
+                scale: -c.y11 / PI,
+            },
         };
         let m = tangential::minimise(&programme, &begin, &begin_status, work)?;
+        work.stiffness = Some((act.clone(), k));
         for (r, &i) in act.iter().enumerate() {
             q[i] = m.q[r];
             out.slip[i] = m.slip[r];

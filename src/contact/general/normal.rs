@@ -4,9 +4,7 @@
 use std::collections::HashSet;
 use std::f64::consts::PI;
 
-use faer::Mat;
-
-use super::dense::{Factored, Workspace};
+use super::dense::{Kernel, NotPositiveDefinite, Workspace};
 use super::influence::Influence;
 use super::mesh::Mesh;
 use super::{Coefficients, ElectricControl};
@@ -127,7 +125,12 @@ fn gaps(input: &NormalInput, sol: &NormalSolution) -> Vec<f64> {
         .collect()
 }
 
-/// The linear contact equations on a fixed set (module docs, "normal subproblem").
+/// The linear contact equations on a fixed set (module docs, "normal subproblem"). With
+/// `G = −L/π` on C (symmetric positive definite) the gap and potential rows read
+/// `Y ⊗ G (p; g) = (b₁ + w δz; b₂ + w φ0)`, `Y = [y22 y23; y23 y33]`, so one factor of G
+/// and the solves `u = G⁻¹b₁`, `v = G⁻¹b₂`, `e = G⁻¹w` give the solution in closed form:
+/// under charge control `δz = (y22 P + y23 Γ − wᵀu)/wᵀe`, `φ0 = (y23 P + y33 Γ − wᵀv)/wᵀe`
+/// and `(p; g) = Y⁻¹ (u + δz e; v + φ0 e)`.
 fn solve_on(
     input: &NormalInput,
     contact: &[bool],
@@ -137,87 +140,91 @@ fn solve_on(
     let mesh = input.mesh;
     let n = mesh.len();
     let act: Vec<usize> = (0..n).filter(|&i| contact[i]).collect();
-    let m = act.len();
-    let (has_g, charge_row) = match (c.electric, input.electric) {
-        (Some(_), ElectricControl::Charge(_)) => (true, true),
-        (Some(_), ElectricControl::Potential(_)) => (true, false),
-        _ => (false, false),
-    };
     let (y23, y33, w13) = c.electric.unwrap_or((0.0, 0.0, 0.0));
-    let size = if has_g { 2 * m + 1 } else { m + 1 } + usize::from(charge_row);
-    let mut a = Mat::<f64>::zeros(size, size);
-    let mut b = vec![0.0; size];
     let mut sq = vec![0.0; n];
     if c.coupled {
         input.influence.sign_apply(input.shear, &mut sq);
     }
-    let col_dz = if has_g { 2 * m } else { m };
-    let cached = matches!(&work.normal, Some((set, _)) if set.as_slice() == contact);
-    for (r, &i) in act.iter().enumerate() {
+    let kernel = Kernel {
+        log: &input.influence.log,
+        scale: -1.0 / PI,
+    };
+    let factor = Workspace::factor(&mut work.normal, kernel, &act).map_err(not_definite)?;
+    let mut b1 = vec![0.0; n];
+    let mut b2 = vec![0.0; n];
+    let mut w = vec![0.0; n];
+    for &i in &act {
         let (x1, x2) = (mesh.edges[i], mesh.edges[i + 1]);
-        let w = x2 - x1;
-        for (k, &j) in act.iter().enumerate().filter(|_| !cached) {
-            let l = input.influence.log[(i, j)];
-            a[(r, k)] = -(c.y22 / PI) * l;
-            if has_g {
-                a[(r, m + k)] = -(y23 / PI) * l;
-                a[(m + r, k)] = -(y23 / PI) * l;
-                a[(m + r, m + k)] = -(y33 / PI) * l;
-            }
-        }
-        a[(r, col_dz)] = -w;
-        b[r] = -c.profile.gap_integral(x1, x2) - 0.5 * c.w12 * sq[i];
-        if has_g {
-            b[m + r] = -0.5 * w13 * sq[i];
-            match input.electric {
-                ElectricControl::Potential(phi) => b[m + r] += w * phi,
-                _ => a[(m + r, col_dz + 1)] = -w,
-            }
+        w[i] = x2 - x1;
+        b1[i] = -c.profile.gap_integral(x1, x2) - 0.5 * c.w12 * sq[i];
+        b2[i] = -0.5 * w13 * sq[i];
+        if let ElectricControl::Potential(phi) = input.electric {
+            b2[i] += w[i] * phi;
         }
     }
-    let row_p = col_dz;
-    for (k, &j) in act.iter().enumerate() {
-        a[(row_p, k)] = mesh.width(j);
-        if charge_row {
-            a[(row_p + 1, m + k)] = mesh.width(j);
-        }
-    }
-    b[row_p] = input.normal_load;
-    if let ElectricControl::Charge(gamma) = input.electric
-        && charge_row
-    {
-        b[row_p + 1] = gamma;
-    }
-    if !cached {
-        let f = Factored::new(a).ok_or(SolveFailure::NonFinite {
-            field: "normal subproblem matrix",
-        })?;
-        work.normal = Some((contact.to_vec(), f));
-    }
-    let factored = &work.normal.as_ref().expect("factored above").1;
-    let x = factored.solve(&b).ok_or(SolveFailure::NonFinite {
-        field: "normal subproblem solution",
-    })?;
+    let on_c = |a: &[f64], b: &[f64]| act.iter().map(|&i| a[i] * b[i]).sum::<f64>();
+    let [u, e, v] = factor.solve([&b1, &w, &b2]);
+    let (wu, we) = (on_c(&w, &u), on_c(&w, &e));
+    let load = input.normal_load;
     let mut pressure = vec![0.0; n];
     let mut charge = vec![0.0; n];
-    for (k, &j) in act.iter().enumerate() {
-        pressure[j] = x[k];
-        if has_g {
-            charge[j] = x[m + k];
+    let (approach, potential) = match (input.electric, c.electric.is_some()) {
+        (ElectricControl::Charge(gamma), true) => {
+            let wv = on_c(&w, &v);
+            let dz = (c.y22 * load + y23 * gamma - wu) / we;
+            let phi = (y23 * load + y33 * gamma - wv) / we;
+            let det = c.y22 * y33 - y23 * y23;
+            // Y⁻¹ = [ya yb; yb yc].
+            let (ya, yb, yc) = (y33 / det, -y23 / det, c.y22 / det);
+            for &i in &act {
+                let (s, t) = (u[i] + dz * e[i], v[i] + phi * e[i]);
+                pressure[i] = ya * s + yb * t;
+                charge[i] = yb * s + yc * t;
+            }
+            (dz, phi)
         }
-    }
-    let potential = match input.electric {
-        ElectricControl::Potential(phi) => phi,
-        _ if charge_row => x[col_dz + 1],
-        _ => 0.0,
+        (ElectricControl::Potential(phi), true) => {
+            // Eliminating g: (y22 − y23²/y33) G p = b₁ − (y23/y33) b₂ + w δz.
+            let wv = on_c(&w, &v);
+            let ratio = y23 / y33;
+            let ystar = c.y22 - y23 * ratio;
+            let dz = (ystar * load - wu + ratio * wv) / we;
+            for &i in &act {
+                pressure[i] = (u[i] - ratio * v[i] + dz * e[i]) / ystar;
+                charge[i] = (v[i] - y23 * pressure[i]) / y33;
+            }
+            (dz, phi)
+        }
+        _ => {
+            let dz = (c.y22 * load - wu) / we;
+            for &i in &act {
+                pressure[i] = (u[i] + dz * e[i]) / c.y22;
+            }
+            (dz, 0.0)
+        }
     };
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    if !(finite(&pressure) && finite(&charge) && approach.is_finite() && potential.is_finite()) {
+        return Err(SolveFailure::NonFinite {
+            field: "normal subproblem solution",
+        });
+    }
     Ok(NormalSolution {
         pressure,
         charge,
-        approach: x[col_dz],
+        approach,
         potential,
         contact: contact.to_vec(),
         iterations: 0,
         cycled: false,
     })
+}
+
+/// The failure of a factor: the kernel is not positive definite on the elements.
+pub(super) fn not_definite(_: NotPositiveDefinite) -> SolveFailure {
+    SolveFailure::NoAdmissibleState {
+        reason: "the logarithmic kernel is not positive definite on the contact elements: \
+                 the datum d must exceed a quarter of the mesh's length"
+            .into(),
+    }
 }

@@ -1,11 +1,14 @@
 //! The tangential subproblem at fixed pressure and charge (module docs of [`super`]): a
-//! strictly convex quadratic programme with box constraints and one equality, solved by a
-//! primal active-set method (Nocedal & Wright, *Numerical Optimization*, Algorithm 16.3).
+//! strictly convex quadratic programme with box constraints and one equality, solved by the
+//! primal–dual active-set method (Hintermüller, Ito & Kunisch 2003) and, if that does not
+//! settle, by the primal active-set method (Nocedal & Wright, *Numerical Optimization*,
+//! Algorithm 16.3).
 
 use faer::Mat;
 
-use super::dense::{Factored, Workspace};
-use super::influence::dot;
+use super::dense::{Kernel, Workspace};
+use super::influence::mat_vec;
+use super::normal::not_definite;
 
 use crate::error::SolveFailure;
 
@@ -22,8 +25,11 @@ pub(super) struct Programme<'a> {
     pub bound: &'a [f64],
     /// Q (N/m).
     pub total: f64,
-    /// The mesh indices of the contact elements (the key of the cached factorizations).
+    /// The mesh indices of the contact elements.
     pub elements: &'a [usize],
+    /// `K` over the whole mesh (`K = kernel` on `elements`), for the factors of its free
+    /// blocks, which are kept by mesh index through the changes of the contact set.
+    pub kernel: Kernel<'a>,
 }
 
 /// Status of one element in the working set.
@@ -96,38 +102,36 @@ fn status_of(q: &[f64], bound: &[f64]) -> Vec<Bound> {
         .collect()
 }
 
-/// The equality-constrained step on the free set: `[K_FF −w_F; w_Fᵀ 0](d; λ) = (−∇_F; 0)`.
+/// The equality-constrained step on the free set: `[K_FF −w_F; w_Fᵀ 0](d; λ) = (−∇_F; 0)`,
+/// by the factor of `K_FF`: `d = λ K_FF⁻¹w_F − K_FF⁻¹∇_F` with
+/// `λ = w_Fᵀ K_FF⁻¹∇_F / w_Fᵀ K_FF⁻¹w_F`.
 fn free_step(
     p: &Programme,
     free: &[usize],
     grad: &[f64],
     work: &mut Workspace,
 ) -> Result<(Vec<f64>, f64), SolveFailure> {
-    let m = free.len();
-    let cached = matches!(&work.tangential, Some((e, f, _)) if e.as_slice() == p.elements && f.as_slice() == free);
-    if !cached {
-        let mut a = Mat::<f64>::zeros(m + 1, m + 1);
-        for (r, &i) in free.iter().enumerate() {
-            for (s, &j) in free.iter().enumerate() {
-                a[(r, s)] = p.k[(i, j)];
-            }
-            a[(r, m)] = -p.w[i];
-            a[(m, r)] = p.w[i];
-        }
-        let f = Factored::new(a).ok_or(SolveFailure::NonFinite {
-            field: "tangential step matrix",
-        })?;
-        work.tangential = Some((p.elements.to_vec(), free.to_vec(), f));
+    let set: Vec<usize> = free.iter().map(|&r| p.elements[r]).collect();
+    let factor = Workspace::factor(&mut work.tangential, p.kernel, &set).map_err(not_definite)?;
+    let size = p.kernel.log.nrows();
+    let mut b = vec![0.0; size];
+    let mut w = vec![0.0; size];
+    for (&r, &i) in free.iter().zip(&set) {
+        b[i] = grad[r];
+        w[i] = p.w[r];
     }
-    let mut b = vec![0.0; m + 1];
-    for (r, &i) in free.iter().enumerate() {
-        b[r] = -grad[i];
+    let [kg, kw] = factor.solve([&b, &w]);
+    let (wkg, wkw) = set.iter().fold((0.0, 0.0), |(a, b), &i| {
+        (a + w[i] * kg[i], b + w[i] * kw[i])
+    });
+    let shift = wkg / wkw;
+    let d: Vec<f64> = set.iter().map(|&i| shift * kw[i] - kg[i]).collect();
+    if !(shift.is_finite() && d.iter().all(|x| x.is_finite())) {
+        return Err(SolveFailure::NonFinite {
+            field: "tangential step",
+        });
     }
-    let factored = &work.tangential.as_ref().expect("factored above").2;
-    let x = factored.solve(&b).ok_or(SolveFailure::NonFinite {
-        field: "tangential step",
-    })?;
-    Ok((x[..m].to_vec(), x[m]))
+    Ok((d, shift))
 }
 
 /// The minimiser, started from the working set `start` (the previous solution's): first by
@@ -185,23 +189,17 @@ fn primal_dual(
             .collect();
         // Make the equality hold through the free elements: Q − (bound part) on them.
         let bound_part: f64 = q.iter().zip(p.w).map(|(q, w)| q * w).sum();
-        let mut grad: Vec<f64> = (0..n)
-            .map(|i| dot(p.k.col_as_slice(i), &q) + p.c[i])
-            .collect();
         let wf: f64 = free.iter().map(|&i| p.w[i] * p.w[i]).sum();
         // A particular free traction meeting the equality, then the free step from it.
         let t = (p.total - bound_part) / wf;
         for &i in &free {
             q[i] = t * p.w[i];
         }
-        for &i in &free {
-            axpy(&mut grad, t * p.w[i], p.k.col_as_slice(i));
-        }
-        let (d, shift) = free_step(p, &free, &grad, work)?;
+        let (d, shift) = free_step(p, &free, &gradient(p, &q), work)?;
         for (k, &i) in free.iter().enumerate() {
             q[i] += d[k];
-            axpy(&mut grad, d[k], p.k.col_as_slice(i));
         }
+        let grad = gradient(p, &q);
         let slip: Vec<f64> = (0..n)
             .map(|i| match status[i] {
                 Bound::Free => 0.0,
@@ -250,9 +248,7 @@ fn primal(
     let mut status = status_of(&q, p.bound);
     let limit = 20 * n + 20;
     for iteration in 1..=limit {
-        let mut grad: Vec<f64> = (0..n)
-            .map(|i| dot(p.k.col_as_slice(i), &q) + p.c[i])
-            .collect();
+        let mut grad = gradient(p, &q);
         let free: Vec<usize> = (0..n).filter(|&i| status[i] == Bound::Free).collect();
         let shift = if free.is_empty() {
             shift_without_free(p, &grad, &status)
@@ -275,13 +271,13 @@ fn primal(
             }
             for (k, &i) in free.iter().enumerate() {
                 q[i] += alpha * d[k];
-                axpy(&mut grad, alpha * d[k], p.k.col_as_slice(i));
             }
             if let Some((i, up)) = blocking {
                 q[i] = if up { p.bound[i] } else { -p.bound[i] };
                 status[i] = if up { Bound::Upper } else { Bound::Lower };
                 continue;
             }
+            grad = gradient(p, &q);
             shift
         };
         let slip: Vec<f64> = (0..n)
@@ -341,11 +337,14 @@ fn shift_without_free(p: &Programme, grad: &[f64], status: &[Bound]) -> f64 {
     }
 }
 
-/// `y += a x`.
-fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
-    for (y, x) in y.iter_mut().zip(x) {
-        *y += a * x;
+/// `∇J = K q + c`.
+fn gradient(p: &Programme, q: &[f64]) -> Vec<f64> {
+    let mut grad = vec![0.0; q.len()];
+    mat_vec(p.k, q, &mut grad);
+    for (g, c) in grad.iter_mut().zip(p.c) {
+        *g += c;
     }
+    grad
 }
 
 #[cfg(test)]
@@ -375,6 +374,10 @@ mod tests {
             bound: &bound,
             total: 0.1,
             elements: &elements,
+            kernel: Kernel {
+                log: &inf.log,
+                scale: -1.0 / std::f64::consts::PI,
+            },
         };
         let tol = 1e-12;
         let a = primal(&p, &vec![0.0; n], tol, &mut Workspace::default()).unwrap();
