@@ -19,8 +19,9 @@
 //!
 //! # Mesh
 //! The band `c ± 1.25a` of the state handed over, graded towards its contact ends
-//! (elements of [`END_SIZE`]·a there, growing by [`GROWTH`] per element up to
-//! [`INNER_SIZE`]·a). The mesh stays for the rest of the run: the state is the slip reference
+//! (elements of [`END_SIZE`]·a there) and its stick ends ([`STICK_SIZE`]·a), growing by
+//! [`GROWTH`] per element up to `numerics.general_element_size`·a ([`INNER_SIZE`] by
+//! default). The mesh stays for the rest of the run: the state is the slip reference
 //! of the next step, and it belongs to its mesh.
 
 use std::sync::Arc;
@@ -41,9 +42,11 @@ use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
 
 /// Element size at the contact ends of the handed-over state, relative to a.
 pub const END_SIZE: f64 = 5e-4;
+/// Element size at the stick ends of the handed-over state, relative to a.
+pub const STICK_SIZE: f64 = 1e-3;
 /// Growth of the element size per element away from the contact ends.
 pub const GROWTH: f64 = 1.06;
-/// Largest element, relative to a.
+/// Largest element, relative to a, by default (`numerics.general_element_size`).
 pub const INNER_SIZE: f64 = 6e-3;
 
 /// Which solver takes the tangential steps (`numerics.solver`).
@@ -72,6 +75,8 @@ pub struct RunOptions {
     /// phase, and the spectral solver's step is handed over when the two disagree
     /// ([`super::continue_run`]).
     pub check_phase_starts: bool,
+    /// The general solver's largest element, relative to the contact half-width.
+    pub general_element_size: f64,
 }
 
 impl RunOptions {
@@ -90,6 +95,7 @@ impl RunOptions {
             slip,
             solver,
             check_phase_starts: solver == SolverChoice::Auto,
+            general_element_size: INNER_SIZE,
         }
     }
 }
@@ -101,6 +107,7 @@ impl RunOptions {
             slip,
             solver: SolverChoice::Spectral,
             check_phase_starts: false,
+            general_element_size: INNER_SIZE,
         }
     }
 }
@@ -203,6 +210,9 @@ pub struct GeneralRun {
     pub steps: usize,
     /// Whether the first phase begun began at the first step (from the handed-over state).
     pub first_began_at_handover: bool,
+    /// The works of P and of the electric load summed over the steps taken (J/m), and those of
+    /// the last step.
+    works: [[f64; 2]; 2],
 }
 
 /// The loads of a state at tangential load `q`.
@@ -219,10 +229,10 @@ pub fn loads_of(model: &ContactModel, normal_load: f64, q: f64) -> Loads {
     }
 }
 
-/// The mesh for a run handed over at a state (module docs).
-pub fn mesh_for(state: &ContactState) -> Mesh {
+/// The mesh for a run handed over at a state, with largest elements `inner`·a (module docs).
+pub fn mesh_for(state: &ContactState, inner: f64) -> Mesh {
     let (c, a) = (state.centre, state.half_width);
-    let focus = [
+    let mut focus = vec![
         Focus {
             at: c - a,
             size: END_SIZE * a,
@@ -232,14 +242,20 @@ pub fn mesh_for(state: &ContactState) -> Mesh {
             size: END_SIZE * a,
         },
     ];
-    Mesh::graded(c - 1.25 * a, c + 1.25 * a, &focus, GROWTH, INNER_SIZE * a)
+    if let Some(zone) = &state.traction.stick {
+        focus.extend([zone.lo, zone.hi].map(|at| Focus {
+            at,
+            size: STICK_SIZE * a,
+        }));
+    }
+    Mesh::graded(c - 1.25 * a, c + 1.25 * a, &focus, GROWTH, inner * a)
 }
 
 impl GeneralRun {
-    /// Take over from the driver's committed state.
-    pub fn handover(model: &ContactModel, driver: &DriverState) -> Self {
+    /// Take over from the driver's committed state, on elements of at most `inner`·a.
+    pub fn handover(model: &ContactModel, driver: &DriverState, inner: f64) -> Self {
         let s = &driver.state;
-        let solver = Arc::new(Solver::new(model, mesh_for(s), Options::default()));
+        let solver = Arc::new(Solver::new(model, mesh_for(s, inner), Options::default()));
         let loads = loads_of(model, s.normal_load, s.tangential_load);
         let state = solver.adopt(s, loads, 0.0);
         Self {
@@ -251,12 +267,20 @@ impl GeneralRun {
             phases_begun: 0,
             steps: 0,
             first_began_at_handover: false,
+            works: [[0.0; 2]; 2],
         }
     }
 
     /// The solver.
     pub fn solver(&self) -> &Arc<Solver> {
         &self.solver
+    }
+
+    /// The works of P and of the electric load summed over the steps taken before the last
+    /// one (J/m).
+    pub fn works_before_this_step(&self) -> [f64; 2] {
+        let [sum, last] = self.works;
+        [sum[0] - last[0], sum[1] - last[1]]
     }
 
     /// Punch displacement δ of the committed state (m).
@@ -313,6 +337,11 @@ impl GeneralRun {
             self.phases_begun += 1;
         }
         let increments = Increments::between(model, &self.state, &new);
+        let last = [increments.normal_work, increments.electric_work];
+        self.works = [
+            [self.works[0][0] + last[0], self.works[0][1] + last[1]],
+            last,
+        ];
         self.state = new;
         self.steps += 1;
         let mut rec = self.record(step, t, regime, Some(&report));

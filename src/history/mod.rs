@@ -59,7 +59,7 @@
 //! [`Recalled::admissibility`]: crate::contact::tangential::Recalled::admissibility
 
 mod driver;
-mod general;
+pub mod general;
 mod hints;
 mod increments;
 mod load;

@@ -14,7 +14,7 @@ use super::driver::{
 use super::general::{GeneralRun, RunOptions, SolverChoice};
 use super::increments::{IncrementInputs, StepIncrements};
 use super::load::{LoadHistory, LoadPoint};
-use super::record::{Observer, StateView, StepFailure, StepRecord};
+use super::record::{NoObserver, Observer, StateView, StepFailure, StepRecord};
 use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
 
 /// A finished run: the records and the final driver state.
@@ -105,8 +105,8 @@ pub fn continue_run(
     records: &mut Vec<StepRecord>,
 ) -> Option<StepFailure> {
     let mut next = 0;
-    let mut general =
-        (options.solver == SolverChoice::General).then(|| GeneralRun::handover(model, driver));
+    let mut general = (options.solver == SolverChoice::General)
+        .then(|| GeneralRun::handover(model, driver, options.general_element_size));
     while next < points.len() {
         let point = points[next];
         let (run, step) = match general.take() {
@@ -132,7 +132,8 @@ pub fn continue_run(
                 match stop.taken {
                     Some((run, record)) => (run, Ok(record)),
                     None => {
-                        let mut run = GeneralRun::handover(model, driver);
+                        let mut run =
+                            GeneralRun::handover(model, driver, options.general_element_size);
                         let step = run.step(model, points[next]);
                         (run, step)
                     }
@@ -143,19 +144,30 @@ pub fn continue_run(
             Ok(record) => record,
             Err(failure) => return Some(failure),
         };
-        observer.on_step(&record, StateView::General(run.solver(), &run.state));
-        let back = options.solver == SolverChoice::Auto
-            && resumes(
+        let mut record = record;
+        let back = match options.solver {
+            SolverChoice::Auto => resumes(
                 model,
                 disc,
                 driver,
                 &run,
                 (points[next], &record),
                 options.slip,
-            );
+            ),
+            _ => None,
+        };
+        if let Some(increments) = &back {
+            // The general steps since the handover add up to the spectral solver's increments
+            // over them: this step takes the rest (see `resumes`).
+            let [normal, electric] = run.works_before_this_step();
+            record.displacement = driver.displacement;
+            record.normal_work = increments.normal_work - normal;
+            record.electric_work = increments.electric_work - electric;
+        }
+        observer.on_step(&record, StateView::General(run.solver(), &run.state));
         records.push(record);
         next += 1;
-        if !back {
+        if back.is_none() {
             general = Some(run);
         }
     }
@@ -164,8 +176,13 @@ pub fn continue_run(
 
 /// Whether the spectral solver takes the state of a general step back: only within the phase
 /// of the handover (its memory is the driver's), and only when it solves the step to its
-/// tolerance, with the same zone structure and the contact and stick ends within the element
-/// size there. The driver then commits that state, with the general run's δ.
+/// tolerance, with the same zone structure and the contact and stick ends within two elements
+/// of the general solver's ([`agrees`]). The driver then commits that state as one step from
+/// its last state, with its own increments: within a phase the spectral state, and δ at a
+/// point that sticks, depend on the memory and Q only, so δ goes on from the spectral
+/// solver's value and the general steps' discretisation error in δ does not accumulate over
+/// cycles. Returns those increments from the state of the handover (δ, and the works of P and
+/// of the electric load, which are differences of state functions too).
 fn resumes(
     model: &ContactModel,
     disc: &Discretisation,
@@ -173,25 +190,26 @@ fn resumes(
     run: &GeneralRun,
     (point, last): (LoadPoint, &StepRecord),
     options: SlipOptions,
-) -> bool {
+) -> Option<StepIncrements> {
     let same_phase =
         run.phases_begun == 0 || (run.phases_begun == 1 && run.first_began_at_handover);
     if !same_phase || last.regime.slip_sign().is_none() {
-        return false;
+        return None;
     }
     let mut trial = driver.clone();
-    let Ok(Solved::Slip(_)) = solve_step(model, disc, &mut trial, point, options) else {
-        return false;
+    let Ok(Solved::Slip(solved)) = solve_step(model, disc, &mut trial, point, options) else {
+        return None;
     };
     let spectral = record(point.step, point.t, &trial, last.regime, None);
     if !agrees(run, last, &spectral) {
-        return false;
+        return None;
     }
-    trial.displacement = run.displacement();
-    trial.anchor_ux = None;
-    trial.approach = None;
+    let increments = solved
+        .known_increments()
+        .unwrap_or_else(|| StepIncrements::compute(model, &solved.increment_inputs(&trial)));
+    finish_step(&mut trial, *solved, increments, &mut NoObserver);
     *driver = trial;
-    true
+    Some(increments)
 }
 
 /// Where the spectral solver stopped: the index of the step it did not take, why, and the
@@ -261,7 +279,8 @@ fn spectral_stretch(
             let solved = solve_step(model, disc, driver, point, options.slip);
             finish(pending.take(), driver, records, observer);
             if let (Some(before), Ok(Solved::Slip(step))) = (before, &solved)
-                && let Some((failure, taken)) = contradicted(model, &before, point, step.record())
+                && let Some((failure, taken)) =
+                    contradicted(model, &before, (point, options), step.record())
             {
                 *driver = before;
                 return Some(Stop {
@@ -326,10 +345,10 @@ fn begins_phase(model: &ContactModel, driver: &DriverState, point: LoadPoint) ->
 fn contradicted(
     model: &ContactModel,
     before: &DriverState,
-    point: LoadPoint,
+    (point, options): (LoadPoint, RunOptions),
     spectral: &StepRecord,
 ) -> Option<(StepFailure, (GeneralRun, StepRecord))> {
-    let mut run = GeneralRun::handover(model, before);
+    let mut run = GeneralRun::handover(model, before, options.general_element_size);
     let general = run.step(model, point).ok()?;
     if agrees(&run, &general, spectral) {
         return None;

@@ -209,7 +209,10 @@ pub fn solve(
             &disc,
             &normal,
             history,
-            RunOptions::new(scenario.solver),
+            RunOptions {
+                general_element_size: scenario.raw.numerics.general_element_size,
+                ..RunOptions::new(scenario.solver)
+            },
             &mut snapshots,
         ) {
             Ok(run) => records = run.records,

@@ -247,6 +247,15 @@ pub struct RawNumerics {
     /// general element solver for the steps it cannot take), `spectral` or `general`.
     #[serde(default)]
     pub solver: crate::history::SolverChoice,
+    /// The general solver's largest element, relative to the contact half-width (in
+    /// [1e−4, 0.05], default 6e−3); its elements are 5e−4 a at the contact ends and 1e−3 a at
+    /// the stick ends of the state it starts from.
+    #[serde(default = "default_general_element_size")]
+    pub general_element_size: f64,
+}
+
+pub(super) fn default_general_element_size() -> f64 {
+    crate::history::general::INNER_SIZE
 }
 
 pub(super) fn default_stick_end_kinks() -> bool {
@@ -268,6 +277,7 @@ impl Default for RawNumerics {
             cycle_tolerance: default_cycle_tolerance(),
             stick_end_kinks: default_stick_end_kinks(),
             solver: crate::history::SolverChoice::default(),
+            general_element_size: default_general_element_size(),
         }
     }
 }

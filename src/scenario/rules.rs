@@ -136,6 +136,13 @@ pub(super) fn validate_numerics(issues: &mut Vec<Issue>, numerics: &RawNumerics)
             format!("{tol} is invalid; it must lie in (0, 1)"),
         ));
     }
+    let h = numerics.general_element_size;
+    if !(1e-4..=0.05).contains(&h) {
+        issues.push(Issue::new(
+            "numerics.general_element_size",
+            format!("{h} is invalid; it must lie in [1e-4, 0.05]"),
+        ));
+    }
     if !(8..=MAX_COLLOCATION_POINTS).contains(&m) {
         issues.push(Issue::new(
             "numerics.collocation_points",

@@ -30,9 +30,11 @@ fn figure3_at_eta_0_1(solver: &str) -> String {
 /// The first reversal of the Figure-3 history at η = 0.1 (step 21, the first step after B)
 /// stops the spectral solver: the receding contact end leaves a layer that slips the old
 /// way, with a second stick zone beside it. Under `auto` the general solver takes that step
-/// and the next ones, finds the layer (a step with two stick zones or with slip of both
-/// signs), and hands back to the spectral solver within the phase once the layers are gone;
-/// the run completes.
+/// and the next ones (and checks the first step of every phase: the first loading step from
+/// Spence's state, whose end zones slip inwards, is its too), finds the layers (a step with
+/// two stick zones or with slip of both signs), and hands back to the spectral solver within
+/// the phase once the layers are gone; the run completes. Where the spectral solver took a
+/// step, its state is the one it reaches alone (it resumes from its own memory).
 #[test]
 fn figure3_history_at_eta_0_1_completes_and_the_spectral_solver_resumes() {
     let spectral =
@@ -47,8 +49,19 @@ fn figure3_history_at_eta_0_1_completes_and_the_spectral_solver_resumes() {
     assert!(auto.failure.is_none(), "{:?}", auto.failure);
     let r = &auto.records;
     assert_eq!(r.len(), 31);
-    // The steps before the reversal are the spectral solver's, unchanged.
-    assert_eq!(&r[..21], &spectral.records[..]);
+    let a = r[0].half_width;
+    for (s, x) in spectral.records.iter().zip(r) {
+        if x.solver == SolverKind::Spectral {
+            for (u, v) in [
+                (s.stick_lo, x.stick_lo),
+                (s.stick_hi, x.stick_hi),
+                (s.half_width, x.half_width),
+                (s.eccentricity, x.eccentricity),
+            ] {
+                assert!((u - v).abs() < 1e-9 * a, "step {}: {u:e} {v:e}", s.step);
+            }
+        }
+    }
     assert_eq!(r[21].solver, SolverKind::General);
     let general: Vec<&StepRecord> = r
         .iter()
@@ -60,7 +73,8 @@ fn figure3_history_at_eta_0_1_completes_and_the_spectral_solver_resumes() {
             .any(|s| s.zones.stick >= 2 || s.zones.sign_changes >= 1),
         "the end layers"
     );
-    assert!(general.len() < 10, "{} general steps", general.len());
+    assert!(general.len() < 15, "{} general steps", general.len());
+    assert_eq!(r[20].solver, SolverKind::Spectral);
     assert_eq!(
         r[30].solver,
         SolverKind::Spectral,
@@ -68,8 +82,7 @@ fn figure3_history_at_eta_0_1_completes_and_the_spectral_solver_resumes() {
     );
     assert_eq!(auto.summary.solver.general_steps, general.len());
     let handovers = &auto.summary.solver.handovers;
-    assert_eq!(handovers.len(), 1, "{handovers:?}");
-    assert_eq!(handovers[0].step, 21);
+    assert!(handovers.iter().any(|h| h.step == 21), "{handovers:?}");
     // δ and the dissipation go on across the handovers: the punch moves back in every step of
     // the reversal, and every step dissipates.
     for w in r[20..].windows(2) {
@@ -80,7 +93,7 @@ fn figure3_history_at_eta_0_1_completes_and_the_spectral_solver_resumes() {
 
 /// The paper's baseline (PZT-4, conducting punch, Γ = 6e−7 C/m, η = 0.3) over one cycle
 /// 0 → 0.5 → −0.5 → 0.5 ηP in steps of 0.1 ηP.
-fn baseline_cycle(solver: &str) -> fretsim::Solution {
+fn baseline_cycle(solver: &str, element: f64) -> fretsim::Solution {
     let text = format!(
         r#"{{
   "name": "baseline_cycle",
@@ -93,37 +106,45 @@ fn baseline_cycle(solver: &str) -> fretsim::Solution {
     "steps_per_segment": 5,
     "max_step": 0.2
   }},
-  "numerics": {{ "solver": "{solver}" }}
+  "numerics": {{ "solver": "{solver}", "general_element_size": {element} }}
 }}"#
     );
     fretsim::solve(&scenario(&text), &mut NoObserver).unwrap()
 }
 
 /// `numerics.solver = general` against the spectral solver over the baseline cycle: every
-/// step's stick ends, half-width and eccentricity within 3e−3 a (measured 2.4e−3 a: a stick
-/// end lies within one element, and the elements inside the contact are 6e−3 a), and the
-/// friction work of the cycle within 0.5 % (measured 0.12 %, the trapezoidal dissipation of
-/// 0.2 ηP steps; 0.011 % with 0.05 ηP steps).
+/// step's stick ends, half-width and eccentricity within one element of the default 6e−3 a
+/// (measured 3.4e−3 a; a stick end lies within an element), within 2e−3 a with elements of
+/// at most 3e−3 a (measured 1.76e−3 a), and the friction work of the cycle within 0.5 %
+/// (measured 0.11–0.12 %, the trapezoidal dissipation of 0.2 ηP steps; 0.011 % with 0.05 ηP
+/// steps).
 #[test]
 fn general_solver_agrees_with_the_spectral_solver_over_a_cycle() {
-    let spectral = baseline_cycle("spectral");
-    let general = baseline_cycle("general");
-    assert!(spectral.failure.is_none() && general.failure.is_none());
+    let spectral = baseline_cycle("spectral", 6e-3);
+    assert!(spectral.failure.is_none());
     assert_eq!(spectral.records.len(), 16);
-    assert_eq!(general.records.len(), 16);
     let a = spectral.records[0].half_width;
-    for (s, g) in spectral.records.iter().zip(&general.records).skip(1) {
-        assert_eq!(g.solver, SolverKind::General);
-        for (x, y) in [
-            (s.stick_lo, g.stick_lo),
-            (s.stick_hi, g.stick_hi),
-            (s.half_width, g.half_width),
-            (s.eccentricity, g.eccentricity),
-        ] {
-            assert!((x - y).abs() < 3e-3 * a, "step {}: {x:e} {y:e}", s.step);
-        }
-    }
     let work = |s: &fretsim::Solution| s.cycles.last().unwrap().friction_work;
-    let change = work(&general) / work(&spectral) - 1.0;
-    assert!(change.abs() < 5e-3, "{change:e}");
+    for (element, bound) in [(6e-3, 6e-3), (3e-3, 2e-3)] {
+        let general = baseline_cycle("general", element);
+        assert!(general.failure.is_none());
+        assert_eq!(general.records.len(), 16);
+        for (s, g) in spectral.records.iter().zip(&general.records).skip(1) {
+            assert_eq!(g.solver, SolverKind::General);
+            for (x, y) in [
+                (s.stick_lo, g.stick_lo),
+                (s.stick_hi, g.stick_hi),
+                (s.half_width, g.half_width),
+                (s.eccentricity, g.eccentricity),
+            ] {
+                assert!(
+                    (x - y).abs() < bound * a,
+                    "{element}, step {}: {x:e} {y:e}",
+                    s.step
+                );
+            }
+        }
+        let change = work(&general) / work(&spectral) - 1.0;
+        assert!(change.abs() < 5e-3, "{element}: {change:e}");
+    }
 }
