@@ -95,13 +95,80 @@ const QUANTITIES: [Quantity; 5] = [
     ),
 ];
 
+/// Where the contact and its stick zone end at one instant (m), marked on the field plots.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ZoneEnds {
+    /// Contact ends `(c − a, c + a)`.
+    pub contact: (f64, f64),
+    /// Stick-zone ends, `None` without friction.
+    pub stick: Option<(f64, f64)>,
+}
+
+impl ZoneEnds {
+    /// The ends of a contact state's contact and stick zone.
+    pub fn of(state: &crate::contact::ContactState) -> Self {
+        Self {
+            contact: (
+                state.centre - state.half_width,
+                state.centre + state.half_width,
+            ),
+            stick: state.traction.stick.as_ref().map(|z| (z.lo, z.hi)),
+        }
+    }
+}
+
+/// The marks of one curve's zone ends on a field plot whose x is divided by `x_scale`: the
+/// stick zone shaded (`shade`, a single curve) or its ends dashed in the curve's colour, and
+/// the contact ends dashed grey.
+fn zone_marks<'a>(
+    ends: &ZoneEnds,
+    x_scale: f64,
+    colour: &'a str,
+    shade: bool,
+    figure: &mut crate::io::svg::Figure<'a>,
+) {
+    use crate::io::svg::{Area, Marker};
+    let (c0, c1) = ends.contact;
+    for x in [c0, c1] {
+        figure.markers.push(Marker {
+            x: x / x_scale,
+            colour: "#777",
+            label: if shade { "contact ends" } else { "" },
+        });
+    }
+    if let Some((s0, s1)) = ends.stick {
+        if shade {
+            figure.areas.push(Area::band(
+                s0 / x_scale,
+                s1 / x_scale,
+                "#4a90d9",
+                0.15,
+                "stick zone",
+            ));
+        } else {
+            for x in [s0, s1] {
+                figure.markers.push(Marker {
+                    x: x / x_scale,
+                    colour,
+                    label: "",
+                });
+            }
+        }
+    }
+}
+
+/// The caption of a family's field plot: what its dashed lines mark.
+const FAMILY_CAPTION: &str =
+    "dashed: stick-zone ends (in the curve's colour) and contact ends (grey)";
+
 /// The plots of the fields at the end of normal loading: p and q together, then g, σxx0 and
-/// Dx0.
+/// Dx0, each with the contact ends (dashed) and the stick zone (shaded) marked.
 pub(crate) fn normal_loading_plots(
     points: &[SurfacePoint],
+    ends: &ZoneEnds,
     scales: &PlotScales,
 ) -> Vec<(String, String)> {
-    use crate::io::svg::{Series, line_plot};
+    use crate::io::svg::{Figure, Series};
     let (x_scale, x_label) = scales.x();
     let field = |f: fn(&SurfacePoint) -> f64, scale: f64| {
         points
@@ -116,26 +183,26 @@ pub(crate) fn normal_loading_plots(
         p_label
             .replacen("p/p0", "p/p0, q/p0", 1)
             .replacen("p (Pa)", "p, q (Pa)", 1);
-    let mut plots = vec![(
-        "normal_loading_tractions".to_string(),
-        line_plot(
-            "End of normal loading: pressure p and shear traction q",
-            &x_label,
-            &tractions_label,
-            &[
-                Series {
-                    label: "p",
-                    points: field(p.2, p_scale),
-                    colour: "black",
-                },
-                Series {
-                    label: "q (on the half-plane)",
-                    points: field(q.2, p_scale),
-                    colour: "crimson",
-                },
-            ],
-        ),
-    )];
+    let mut tractions = Figure {
+        title: "End of normal loading: pressure p and shear traction q".into(),
+        x_label: x_label.clone(),
+        y_label: tractions_label,
+        series: vec![
+            Series {
+                label: "p",
+                points: field(p.2, p_scale),
+                colour: "black",
+            },
+            Series {
+                label: "q (on the half-plane)",
+                points: field(q.2, p_scale),
+                colour: "crimson",
+            },
+        ],
+        ..Figure::default()
+    };
+    zone_marks(ends, x_scale, "black", true, &mut tractions);
+    let mut plots = vec![("normal_loading_tractions".to_string(), tractions.svg())];
     let names = [
         "normal_loading_charge",
         "normal_loading_sigma_xx",
@@ -143,54 +210,67 @@ pub(crate) fn normal_loading_plots(
     ];
     for ((_, title, f, scale), name) in rest.iter().zip(names) {
         let (s, label) = scale(scales);
-        plots.push((
-            name.to_string(),
-            line_plot(
-                &format!("End of normal loading: {}", title.to_lowercase()),
-                &x_label,
-                &label,
-                &[Series {
-                    label: "",
-                    points: field(*f, s),
-                    colour: "black",
-                }],
-            ),
-        ));
+        let mut figure = Figure {
+            title: format!("End of normal loading: {}", title.to_lowercase()),
+            x_label: x_label.clone(),
+            y_label: label,
+            series: vec![Series {
+                label: "",
+                points: field(*f, s),
+                colour: "black",
+            }],
+            ..Figure::default()
+        };
+        zone_marks(ends, x_scale, "black", true, &mut figure);
+        plots.push((name.to_string(), figure.svg()));
     }
     plots
 }
 
+/// One member of a family of field curves: legend label, samples and zone ends.
+pub type FamilyMember<'a> = (&'a str, &'a [SurfacePoint], ZoneEnds);
+
 /// One plot per field quantity (p, q, g, σxx0, Dx0) with one curve per member of a family
-/// (snapshot instants of a run, or variants of a sweep), named `<prefix>_<quantity>`. Empty
-/// when the family is empty.
+/// (snapshot instants of a run, or variants of a sweep), named `<prefix>_<quantity>`, each
+/// member's stick-zone ends dashed in its colour and its contact ends dashed grey (a single
+/// member: the stick zone shaded). Empty when the family is empty.
 pub fn family_plots(
     prefix: &str,
     what: &str,
-    family: &[(&str, &[SurfacePoint])],
+    family: &[FamilyMember<'_>],
     scales: &PlotScales,
 ) -> Vec<(String, String)> {
-    use crate::io::svg::{PALETTE, Series, line_plot};
+    use crate::io::svg::{Figure, PALETTE, Series};
     if family.is_empty() {
         return Vec::new();
     }
     let (x_scale, x_label) = scales.x();
+    let single = family.len() == 1;
     QUANTITIES
         .iter()
         .map(|(key, title, f, scale)| {
             let (s, y_label) = scale(scales);
-            let series: Vec<Series> = family
-                .iter()
-                .enumerate()
-                .map(|(k, (label, points))| Series {
+            let mut figure = Figure {
+                title: format!("{title} {what}"),
+                x_label: x_label.clone(),
+                y_label,
+                caption: if single {
+                    String::new()
+                } else {
+                    FAMILY_CAPTION.into()
+                },
+                ..Figure::default()
+            };
+            for (k, (label, points, ends)) in family.iter().enumerate() {
+                let colour = PALETTE[k % PALETTE.len()];
+                figure.series.push(Series {
                     label,
                     points: points.iter().map(|p| (p.x / x_scale, f(p) / s)).collect(),
-                    colour: PALETTE[k % PALETTE.len()],
-                })
-                .collect();
-            (
-                format!("{prefix}_{key}"),
-                line_plot(&format!("{title} {what}"), &x_label, &y_label, &series),
-            )
+                    colour,
+                });
+                zone_marks(ends, x_scale, colour, single, &mut figure);
+            }
+            (format!("{prefix}_{key}"), figure.svg())
         })
         .collect()
 }

@@ -12,7 +12,10 @@ use crate::error::Error;
 use crate::history::StepRecord;
 use crate::io::csv::{cycles_table, fields_table, steps_table};
 use crate::io::folder::{Protected, RunFolder};
-use crate::io::plots::{PlotScales, family_plots, history_plots, index_html, normal_loading_plots};
+use crate::io::plots::{
+    FamilyMember, PlotScales, ZoneEnds, family_plots, history_plots, index_html,
+    normal_loading_plots,
+};
 use crate::io::summary::{
     Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary, solver_statistics,
 };
@@ -71,6 +74,8 @@ pub struct FieldSet {
     pub label: String,
     /// The samples.
     pub points: Vec<SurfacePoint>,
+    /// Where the contact and the stick zone end (marked on the plots).
+    pub ends: ZoneEnds,
 }
 
 /// Keeps, while the history runs, the states that the field files need: the turning points
@@ -217,6 +222,7 @@ pub fn solve(
         stem: "normal_loading".into(),
         label: "end of normal loading".into(),
         points: sample(&normal.state),
+        ends: ZoneEnds::of(&normal.state),
     }];
     let (at_snapshots, snapshot_rows) = snapshot_fields(
         scenario,
@@ -248,6 +254,7 @@ pub fn solve(
                 stem: format!("step_{:05}", rec.step),
                 label: format!("step {}", rec.step),
                 points: sample(state),
+                ends: ZoneEnds::of(state),
             });
         }
     }
@@ -321,6 +328,7 @@ fn snapshot_fields(
             label: format!("t = {t} s, Q/(ηP) = {:.3}", rec.q / limit),
             stem: stem.clone(),
             points: sample(state),
+            ends: ZoneEnds::of(state),
         });
         rows.push(SnapshotSummary {
             t,
@@ -386,15 +394,15 @@ pub(crate) fn write_solution(
         };
         section(
             "End of normal loading",
-            normal_loading_plots(&fields[0].points, &scales),
+            normal_loading_plots(&fields[0].points, &fields[0].ends, &scales),
         )?;
         section(
             "Load history",
             history_plots(records, limit, failure.is_some()),
         )?;
-        let instants: Vec<(&str, &[SurfacePoint])> = fields[1..]
+        let instants: Vec<FamilyMember> = fields[1..]
             .iter()
-            .map(|f| (f.label.as_str(), f.points.as_slice()))
+            .map(|f| (f.label.as_str(), f.points.as_slice(), f.ends))
             .collect();
         section(
             "Fields at the snapshot instants",

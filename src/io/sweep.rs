@@ -4,12 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::contact::SurfacePoint;
 use crate::contact::normal::{NormalOptions, solve_normal};
 use crate::contact::pressure::Discretisation;
 use crate::error::Error;
 use crate::io::folder::{Protected, RunFolder, SweepFolder};
-use crate::io::plots::{PlotScales, family_plots, index_html};
+use crate::io::plots::{FamilyMember, PlotScales, family_plots, index_html};
 use crate::io::run::{FieldSet, run_partial};
 use crate::io::summary::{NormalSummary, normal_summary};
 use crate::scenario::Scenario;
@@ -602,12 +601,12 @@ pub(crate) fn write_comparison(
     }
     let mut sections = Vec::new();
     for stem in &stems {
-        let family: Vec<(&str, &[SurfacePoint])> = labels
+        let family: Vec<FamilyMember> = labels
             .iter()
             .zip(outcomes)
             .filter_map(|(label, o)| {
                 let set = o.fields.iter().find(|f| &f.stem == stem)?;
-                Some((label.as_str(), set.points.as_slice()))
+                Some((label.as_str(), set.points.as_slice(), set.ends))
             })
             .collect();
         let what = match scenarios.first() {
