@@ -13,6 +13,7 @@
 
 pub mod csv;
 pub mod folder;
+pub mod history_plots;
 pub mod plots;
 pub mod run;
 pub mod summary;

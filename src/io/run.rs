@@ -12,9 +12,9 @@ use crate::error::Error;
 use crate::history::StepRecord;
 use crate::io::csv::{cycles_table, fields_table, steps_table};
 use crate::io::folder::{Protected, RunFolder};
+use crate::io::history_plots::history_plots;
 use crate::io::plots::{
-    FamilyMember, PlotScales, ZoneEnds, family_plots, history_plots, index_html,
-    normal_loading_plots,
+    FamilyMember, PlotScales, ZoneEnds, family_plots, index_html, normal_loading_plots,
 };
 use crate::io::summary::{
     Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary, solver_statistics,
