@@ -15,6 +15,7 @@ pub mod csv;
 pub mod folder;
 pub mod history_plots;
 pub mod plots;
+pub mod png;
 pub mod run;
 pub mod summary;
 pub mod svg;

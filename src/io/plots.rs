@@ -129,7 +129,16 @@ fn zone_marks<'a>(
 ) {
     use crate::io::svg::{Area, Marker};
     let (c0, c1) = ends.contact;
+    // A family's contact ends that nearly coincide (within 0.2 % of a) are drawn once.
+    let tolerance = 2e-3 * 0.5 * (c1 - c0).abs() / x_scale;
     for x in [c0, c1] {
+        let drawn = figure
+            .markers
+            .iter()
+            .any(|m| m.colour == "#777" && (m.x - x / x_scale).abs() <= tolerance);
+        if drawn {
+            continue;
+        }
         figure.markers.push(Marker {
             x: x / x_scale,
             colour: "#777",

@@ -16,6 +16,7 @@ use crate::io::history_plots::history_plots;
 use crate::io::plots::{
     FamilyMember, PlotScales, ZoneEnds, family_plots, index_html, normal_loading_plots,
 };
+use crate::io::png::plot_files;
 use crate::io::summary::{
     Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary, solver_statistics,
 };
@@ -383,8 +384,16 @@ pub(crate) fn write_solution(
         }
         let mut section = |title: &str, plots: Vec<(String, String)>| -> Result<(), Error> {
             let mut names = Vec::new();
-            for (name, svg) in plots {
-                put(format!("plots/{name}.svg"), svg.as_bytes())?;
+            use rayon::prelude::*;
+            // PNG rendering is the slow part: the plots of a section in parallel.
+            let files = plots
+                .par_iter()
+                .map(|(name, svg)| plot_files(name, svg, scenario.raw.output.png))
+                .collect::<Result<Vec<_>, Error>>()?;
+            for ((name, _), files) in plots.into_iter().zip(files) {
+                for (path, bytes) in files {
+                    put(path, &bytes)?;
+                }
                 names.push(name);
             }
             if !names.is_empty() {

@@ -599,6 +599,8 @@ pub(crate) fn write_comparison(
                 .map(|t| crate::scenario::snapshot_stem(*t)),
         );
     }
+    // PNG files as the scenario asks (the variants share the output options).
+    let png = scenarios.first().is_none_or(|(_, _, sc)| sc.raw.output.png);
     let mut sections = Vec::new();
     for stem in &stems {
         let family: Vec<FamilyMember> = labels
@@ -625,10 +627,9 @@ pub(crate) fn write_comparison(
         let plots = family_plots(&format!("compare_{stem}"), &what, &family, &PlotScales::SI);
         let mut names = Vec::new();
         for (name, svg) in plots {
-            crate::io::folder::write_atomic(
-                &out_dir.join("plots").join(format!("{name}.svg")),
-                svg.as_bytes(),
-            )?;
+            for (path, bytes) in crate::io::png::plot_files(&name, &svg, png)? {
+                crate::io::folder::write_atomic(&out_dir.join(path), &bytes)?;
+            }
             names.push(name);
         }
         if !names.is_empty() {

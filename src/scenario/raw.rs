@@ -56,6 +56,10 @@ pub struct RawOutput {
     /// loading; the default) or `si`.
     #[serde(default)]
     pub plot_units: PlotUnits,
+    /// Also write each plot as a PNG beside its SVG (`plots/<name>.png`, 300 dpi at the plot's
+    /// nominal size; default true).
+    #[serde(default = "default_true")]
+    pub png: bool,
 }
 
 /// Axes of the field plots.
@@ -76,6 +80,7 @@ impl Default for RawOutput {
             turning_point_fields: true,
             field_points: default_field_points(),
             plot_units: PlotUnits::default(),
+            png: true,
         }
     }
 }
