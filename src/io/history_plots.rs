@@ -181,7 +181,7 @@ fn zone_plot(records: &[StepRecord], note: &str) -> String {
         .unzip();
     figure.areas.push(Area {
         points: band(lo, hi),
-        fill: "#999",
+        fill: "#999".into(),
         opacity: 0.25,
         label: "contact",
     });
@@ -211,7 +211,7 @@ fn zone_plot(records: &[StepRecord], note: &str) -> String {
                 for (from, to) in [(pl, l), (ph, h)] {
                     figure.areas.push(Area {
                         points: vec![(t0, from), (t1, from), (t1, to)],
-                        fill: "darkorange",
+                        fill: "darkorange".into(),
                         opacity: 0.6,
                         label: "at |q| = ηp, no slip (recalled state)",
                     });
@@ -222,7 +222,7 @@ fn zone_plot(records: &[StepRecord], note: &str) -> String {
         }
         figure.areas.push(Area {
             points: band(lower, upper),
-            fill: "#1f5fb4",
+            fill: "#1f5fb4".into(),
             opacity: 0.45,
             label: "stick zone (|q| < ηp)",
         });

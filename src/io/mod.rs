@@ -20,6 +20,7 @@ pub mod run;
 pub mod summary;
 pub mod svg;
 pub mod sweep;
+mod sweep_plots;
 
 pub use run::{RunResult, Solution, run, run_with, solve};
 pub use sweep::{Shard, SweepOptions, SweepOutput, Vary, sweep};

@@ -284,24 +284,66 @@ pub fn family_plots(
         .collect()
 }
 
-/// `index.html`: every plot on one page, in sections, and links to every file.
+/// `index.html`: a contents list (a link to each section), then every plot on one page, in
+/// sections (each plot shown by its SVG, with a link to it), and links to
+/// every file.
 pub fn index_html(name: &str, sections: &[(String, Vec<String>)], files: &[String]) -> String {
     use crate::io::svg::escape;
     let name = escape(name);
+    let anchor = |k: usize| format!("section-{}", k + 1);
+    let mut contents = String::from("<nav><h2>Contents</h2>\n<ol>\n");
     let mut body = String::new();
-    for (title, plots) in sections {
-        body.push_str(&format!("<h2>{}</h2>\n", escape(title)));
+    for (k, (title, plots)) in sections.iter().enumerate() {
+        let title = escape(title);
+        contents.push_str(&format!(
+            "<li><a href=\"#{}\">{title}</a> ({} plot{})</li>\n",
+            anchor(k),
+            plots.len(),
+            if plots.len() == 1 { "" } else { "s" }
+        ));
+        body.push_str(&format!("<h2 id=\"{}\">{title}</h2>\n", anchor(k)));
         for p in plots {
             body.push_str(&format!(
-                "<figure><img src=\"plots/{p}.svg\" alt=\"{p}\"><figcaption>plots/{p}.svg</figcaption></figure>\n"
+                "<figure id=\"{p}\"><img src=\"plots/{p}.svg\" alt=\"{p}\" style=\"max-width:100%\"><figcaption><a href=\"plots/{p}.svg\">plots/{p}.svg</a></figcaption></figure>\n"
             ));
         }
     }
+    contents.push_str("<li><a href=\"#files\">Files</a></li>\n</ol></nav>\n");
     let links: String = files
         .iter()
         .map(|f| format!("<li><a href=\"{f}\">{f}</a></li>\n", f = escape(f)))
         .collect();
     format!(
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>fretsim: {name}</title></head>\n<body>\n<h1>fretsim: {name}</h1>\n<p>Columns and units of every file: see the fretsim README.</p>\n{body}<h2>Files</h2>\n<ul>\n{links}</ul>\n</body></html>\n"
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>fretsim: {name}</title></head>\n<body>\n<h1>fretsim: {name}</h1>\n<p>Columns and units of every file: see the fretsim README.</p>\n{contents}{body}<h2 id=\"files\">Files</h2>\n<ul>\n{links}</ul>\n</body></html>\n"
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_page_opens_with_a_contents_list_of_its_sections() {
+        let sections = vec![
+            (
+                "Results against friction".to_string(),
+                vec!["sweep_b_over_a".to_string()],
+            ),
+            (
+                "Fields & more".to_string(),
+                vec!["a".to_string(), "b".to_string()],
+            ),
+        ];
+        let html = index_html("s", &sections, &["sweep.csv".to_string()]);
+        let contents = html.find("<h2>Contents</h2>").unwrap();
+        assert!(contents < html.find("<h2 id=\"section-1\">").unwrap());
+        assert!(
+            html.contains("<li><a href=\"#section-1\">Results against friction</a> (1 plot)</li>")
+        );
+        assert!(html.contains("<li><a href=\"#section-2\">Fields &amp; more</a> (2 plots)</li>"));
+        assert!(html.contains("<h2 id=\"section-2\">Fields &amp; more</h2>"));
+        assert!(
+            html.contains("<a href=\"#files\">Files</a>") && html.contains("<h2 id=\"files\">")
+        );
+    }
 }

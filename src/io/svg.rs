@@ -77,7 +77,7 @@ pub struct Area<'a> {
     /// Vertices, in data units.
     pub points: Vec<(f64, f64)>,
     /// Fill colour.
-    pub fill: &'a str,
+    pub fill: String,
     /// Fill opacity in [0, 1].
     pub opacity: f64,
     /// Legend label (empty: not listed; areas of one label are listed once).
@@ -86,11 +86,11 @@ pub struct Area<'a> {
 
 impl<'a> Area<'a> {
     /// A band across the whole height of the plot over `x0 ≤ x ≤ x1`.
-    pub fn band(x0: f64, x1: f64, fill: &'a str, opacity: f64, label: &'a str) -> Self {
+    pub fn band(x0: f64, x1: f64, fill: &str, opacity: f64, label: &'a str) -> Self {
         let inf = f64::INFINITY;
         Self {
             points: vec![(x0, -inf), (x1, -inf), (x1, inf), (x0, inf)],
-            fill,
+            fill: fill.into(),
             opacity,
             label,
         }
@@ -103,6 +103,8 @@ pub struct Note {
     pub at: (f64, f64),
     /// The text.
     pub text: String,
+    /// Text colour.
+    pub colour: &'static str,
 }
 
 /// A plot: curves, shaded areas below them, dashed vertical markers and notes, with axes,
@@ -124,6 +126,8 @@ pub struct Figure<'a> {
     pub markers: Vec<Marker<'a>>,
     /// Notes.
     pub notes: Vec<Note>,
+    /// Points drawn as dots: `(x, y, colour)` (the samples of a sweep).
+    pub dots: Vec<(f64, f64, &'a str)>,
     /// A line of small text under the title (what the marks mean).
     pub caption: String,
 }
@@ -152,8 +156,9 @@ fn data_range(figure: &Figure<'_>) -> (f64, f64, f64, f64) {
     let pts = figure
         .series
         .iter()
-        .flat_map(|s| s.points.iter())
-        .chain(figure.areas.iter().flat_map(|a| a.points.iter()))
+        .flat_map(|s| s.points.iter().copied())
+        .chain(figure.areas.iter().flat_map(|a| a.points.iter().copied()))
+        .chain(figure.dots.iter().map(|&(x, y, _)| (x, y)))
         .filter(|(x, y)| x.is_finite() && y.is_finite());
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
@@ -162,10 +167,10 @@ fn data_range(figure: &Figure<'_>) -> (f64, f64, f64, f64) {
         f64::NEG_INFINITY,
     );
     for (x, y) in pts {
-        x0 = x0.min(*x);
-        x1 = x1.max(*x);
-        y0 = y0.min(*y);
-        y1 = y1.max(*y);
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
     }
     for m in figure.markers.iter().filter(|m| m.x.is_finite()) {
         x0 = x0.min(m.x);
@@ -181,7 +186,13 @@ fn data_range(figure: &Figure<'_>) -> (f64, f64, f64, f64) {
         y1 = y0 + 1.0;
     }
     let pad = 0.05 * (y1 - y0);
-    (x0, x1, y0 - pad, y1 + pad)
+    // Dots at the ends of the x range stay whole.
+    let x_pad = if figure.dots.is_empty() {
+        0.0
+    } else {
+        0.03 * (x1 - x0)
+    };
+    (x0 - x_pad, x1 + x_pad, y0 - pad, y1 + pad)
 }
 
 /// The sample drawn beside a legend label.
@@ -227,7 +238,7 @@ fn legend_entries<'a>(figure: &'a Figure<'a>) -> Vec<(&'a str, Swatch<'a>)> {
     let areas = figure
         .areas
         .iter()
-        .map(|a| (a.label, Swatch::Fill(a.fill, a.opacity)));
+        .map(|a| (a.label, Swatch::Fill(a.fill.as_str(), a.opacity)));
     let markers = figure
         .markers
         .iter()
@@ -287,7 +298,7 @@ impl Figure<'_> {
             w - left - right,
             h - top - bottom
         );
-        for a in &self.areas {
+        for a in self.areas.iter().filter(|a| !a.points.is_empty()) {
             // An infinite y stands for the plot area's edge (a band across the plot).
             let path: Vec<String> = a
                 .points
@@ -327,13 +338,26 @@ impl Figure<'_> {
                 path.join(" ")
             );
         }
+        for (x, y, colour) in self
+            .dots
+            .iter()
+            .filter(|d| d.0.is_finite() && d.1.is_finite())
+        {
+            let _ = write!(
+                svg,
+                r#"<circle cx="{:.2}" cy="{:.2}" r="3.5" fill="{colour}"/>"#,
+                sx(*x),
+                sy(*y)
+            );
+        }
         svg.push_str("</g>");
         for n in &self.notes {
             let _ = write!(
                 svg,
-                r#"<text x="{:.1}" y="{:.1}" text-anchor="middle" font-size="11">{}</text>"#,
+                r#"<text x="{:.1}" y="{:.1}" text-anchor="middle" font-size="11" fill="{}">{}</text>"#,
                 sx(n.at.0),
                 sy(n.at.1) + 4.0,
+                n.colour,
                 escape(&n.text)
             );
         }
