@@ -246,3 +246,94 @@ pub(crate) fn history_plots(
     plots.push(("stick_zone".into(), zone_plot(records, note)));
     plots
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::history::NoObserver;
+
+    fn records_of(scenario: &crate::scenario::Scenario) -> Vec<StepRecord> {
+        let solution = crate::io::solve(scenario, &mut NoObserver).unwrap();
+        assert!(solution.failure.is_none());
+        solution.records
+    }
+
+    fn scenario_file(name: &str) -> crate::scenario::Scenario {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios")
+            .join(name);
+        crate::scenario::load(&path).unwrap()
+    }
+
+    /// Within each phase the slip displacement δ − C·Q moves with Q, never against it: the
+    /// loop does not bend back. Checked on the coupled contacts where the first loading's
+    /// slope made it bend back (by 70 % and 230 % of the slip range).
+    #[test]
+    fn the_slip_displacement_loop_never_bends_back() {
+        for name in ["figure3_history_insulating.json", "figure4_fretting.json"] {
+            let records = records_of(&scenario_file(name));
+            let (c, source) = stuck_compliance(&records).unwrap();
+            assert_eq!(source, ComplianceSource::Reversals, "{name}");
+            let slip = |r: &StepRecord| r.displacement - c * r.q;
+            let range = records.iter().map(slip).fold(f64::NEG_INFINITY, f64::max)
+                - records.iter().map(slip).fold(f64::INFINITY, f64::min);
+            for w in records.windows(2) {
+                if w[0].phase != w[1].phase || w[1].phase == 0 {
+                    continue;
+                }
+                let back = -(slip(&w[1]) - slip(&w[0])) * (w[1].q - w[0].q).signum();
+                // Round-off of δ and of the extrapolated slope: 1e-6 of the slip range.
+                assert!(
+                    back <= 1e-6 * range,
+                    "{name}: step {} goes back by {back:e}",
+                    w[1].step
+                );
+            }
+        }
+    }
+
+    /// A history without a reversal takes C from the start of its loading, exactly for a
+    /// quadratic δ(Q).
+    #[test]
+    fn without_a_reversal_c_is_the_first_loadings_slope() {
+        let mut records = records_of(&crate::scenario::default_scenario());
+        records.retain(|r| r.phase <= 1);
+        for r in &mut records {
+            r.displacement = 3e-11 * r.q + 1e-15 * r.q * r.q;
+        }
+        let (c, source) = stuck_compliance(&records).unwrap();
+        assert_eq!(source, ComplianceSource::FirstLoading);
+        assert!((c - 3e-11).abs() < 1e-9 * 3e-11, "{c:e}");
+    }
+
+    /// The default history returns to −Qmax at steps 70 and 110 in a state recalled from
+    /// step 30; the zone plot draws them as orange wedges and no polyline at all.
+    #[test]
+    fn recalled_turning_states_are_drawn_as_bands() {
+        let records = records_of(&crate::scenario::default_scenario());
+        let recalled: Vec<usize> = recalled_steps(&records)
+            .iter()
+            .enumerate()
+            .filter_map(|(k, r)| r.then_some(records[k].step))
+            .collect();
+        assert_eq!(recalled, [70, 110]);
+        let svg = zone_plot(&records, "");
+        assert_eq!(svg.matches("<polyline").count(), 0);
+        let phases = records.last().unwrap().phase;
+        // The contact, one stick band per phase, two wedges per recalled step.
+        assert_eq!(
+            svg.matches(r#"class="area""#).count(),
+            1 + phases + 2 * recalled.len()
+        );
+        assert!(svg.contains(r#"fill="darkorange""#));
+        assert!(svg.contains("stick zone (|q| &lt; ηp)"));
+        let plots = history_plots(&records, 1.0, false);
+        let names: Vec<&str> = plots.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["hysteresis", "hysteresis_slip", "stick_zone"]);
+        assert!(
+            plots[1]
+                .1
+                .contains("the least slope dδ/dQ at a load reversal")
+        );
+    }
+}

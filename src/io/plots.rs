@@ -322,6 +322,88 @@ pub fn index_html(name: &str, sections: &[(String, Vec<String>)], files: &[Strin
 mod tests {
     use super::*;
 
+    fn samples() -> Vec<SurfacePoint> {
+        (0..9)
+            .map(|k| {
+                let x = (k as f64 - 4.0) * 0.5e-5;
+                SurfacePoint {
+                    x,
+                    pressure: (1.0 - (x / 2e-5).powi(2)).max(0.0),
+                    traction: 0.1 * x,
+                    charge: 0.0,
+                    sigma_xx: -1.0,
+                    d_x: 0.0,
+                }
+            })
+            .collect()
+    }
+
+    const ENDS: ZoneEnds = ZoneEnds {
+        contact: (-2e-5, 2e-5),
+        stick: Some((-1.5e-5, 1e-5)),
+    };
+
+    /// p, q, g and σxx0 at the end of normal loading: the contact ends dashed at x/a = ±1 and
+    /// the stick zone shaded over [−0.75, 0.5] a, both in the legend.
+    #[test]
+    fn normal_loading_plots_mark_the_contact_ends_and_shade_the_stick_zone() {
+        let scales = PlotScales::normalised(2e-5, 1.0, 0.3, 0.0);
+        let plots = normal_loading_plots(&samples(), &ENDS, &scales);
+        assert_eq!(plots.len(), 4);
+        for (name, svg) in &plots {
+            assert_eq!(svg.matches(r#"class="marker""#).count(), 2, "{name}");
+            assert_eq!(svg.matches(r#"class="area""#).count(), 1, "{name}");
+            assert!(
+                svg.contains(">contact ends<") && svg.contains(">stick zone<"),
+                "{name}"
+            );
+        }
+        let svg = &plots[0].1;
+        let xs: Vec<f64> = svg
+            .split(r#"class="marker" x1=""#)
+            .skip(1)
+            .map(|s| s.split('"').next().unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(xs.len(), 2);
+        // x spans [−1, 1] (the samples): the markers at the plot area's edges.
+        assert!(
+            (xs[0] - 90.0).abs() < 0.01 && (xs[1] - 710.0).abs() < 0.01,
+            "{xs:?}"
+        );
+    }
+
+    /// A family marks each member's stick-zone ends dashed in its colour (no band) and the
+    /// contact ends that coincide once.
+    #[test]
+    fn family_plots_dash_each_members_stick_ends_and_shared_contact_ends_once() {
+        let points = samples();
+        let other = ZoneEnds {
+            contact: ENDS.contact,
+            stick: Some((-1e-5, 1.5e-5)),
+        };
+        let family: Vec<FamilyMember> = vec![("A", &points, ENDS), ("B", &points, other)];
+        let plots = family_plots("snapshots", "at t", &family, &PlotScales::SI);
+        assert_eq!(plots.len(), 5);
+        for (name, svg) in &plots {
+            assert_eq!(svg.matches(r#"class="area""#).count(), 0, "{name}");
+            assert_eq!(
+                svg.matches(r#"class="marker""#).count(),
+                2 + 2 + 2,
+                "{name}"
+            );
+            assert_eq!(svg.matches(r##"class="marker" x1"##).count(), 6);
+            assert!(svg.contains(crate::io::svg::PALETTE[1]));
+            assert!(svg.contains("dashed: stick-zone ends"));
+        }
+        // A single member is drawn like a normal-loading plot: the stick zone shaded.
+        let plots = family_plots("snapshots", "at t", &family[..1], &PlotScales::SI);
+        assert!(
+            plots
+                .iter()
+                .all(|(_, svg)| svg.matches(r#"class="area""#).count() == 1)
+        );
+    }
+
     #[test]
     fn the_page_opens_with_a_contents_list_of_its_sections() {
         let sections = vec![
