@@ -29,7 +29,7 @@ fn slope_at(records: &[StepRecord], [i, j, k]: [usize; 3]) -> Option<f64> {
     let dq = |m: usize, n: usize| q(n) - q(m);
     if [dq(i, j), dq(j, k), dq(i, k)]
         .iter()
-        .any(|x| !(x.abs() > 0.0))
+        .any(|x| x.abs() < f64::MIN_POSITIVE)
     {
         return None;
     }

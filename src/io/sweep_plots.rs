@@ -109,10 +109,13 @@ fn line_plots(field: &str, x: &[f64], results: &[&ResultColumn]) -> Vec<(String,
         .collect()
 }
 
+/// A variant's cell of a map: its centre (the two varied values) and its x and y extents.
+type Cell = ((f64, f64), (f64, f64), (f64, f64));
+
 /// The grid of a two-field sweep: the cell of each variant (from its two values).
 struct Grid<'a> {
     fields: [&'a str; 2],
-    cells: Vec<((f64, f64), (f64, f64), (f64, f64))>,
+    cells: Vec<Cell>,
 }
 
 impl<'a> Grid<'a> {
