@@ -129,8 +129,8 @@ fn zone_marks<'a>(
 ) {
     use crate::io::svg::{Area, Marker};
     let (c0, c1) = ends.contact;
-    // A family's contact ends that nearly coincide (within 0.2 % of a) are drawn once.
-    let tolerance = 2e-3 * 0.5 * (c1 - c0).abs() / x_scale;
+    // A family's contact ends that nearly coincide (within 1 % of a) are drawn once.
+    let tolerance = 1e-2 * 0.5 * (c1 - c0).abs() / x_scale;
     for x in [c0, c1] {
         let drawn = figure
             .markers
