@@ -6,8 +6,9 @@
 //! - [`mod@run`]: [`solve`] (a scenario's results, nothing written) and [`run()`] (solve, then write
 //!   the output folder);
 //! - [`summary`]: the contents of `summary.json`;
-//! - [`csv`], [`plots`], [`svg`]: the files of a run;
-//! - [`mod@sweep`]: `fretsim sweep`;
+//! - [`csv`], [`plots`], [`history_plots`], [`svg`]: the files of a run; [`png`]: the PNG
+//!   beside each SVG plot (resvg, embedded font);
+//! - [`mod@sweep`]: `fretsim sweep`, and its result plots and maps (`sweep_plots`);
 //! - [`folder`]: the output folder's rules: never touch what fretsim did not write, replace a
 //!   previous output atomically.
 
