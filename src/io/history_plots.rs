@@ -15,8 +15,8 @@
 //! returns to a stored turning point (Masing memory) the state *is* the stored one, and its
 //! stick zone is the zone where |q| < ηp in that state; the points between it and the
 //! previous step's stick zone sit at the friction limit without having slipped in the
-//! current phase. Such a recalled step (a state equal to an earlier step's, reached from a
-//! different previous step) is drawn as its own shaded wedge, so the reporting rule shows as
+//! current phase. Such a recalled step (a state equal to an earlier phase's turning state,
+//! reached from a different previous step) is drawn as its own shaded wedge, so the reporting rule shows as
 //! a band and not as a spike of the stick-end line.
 
 use crate::history::StepRecord;
@@ -87,19 +87,45 @@ fn same_state(a: &StepRecord, b: &StepRecord) -> bool {
         && close(a.displacement, b.displacement, 1e-6 * length)
 }
 
-/// For each record, whether it is a recalled state (module docs): equal to an earlier step
-/// of another phase whose previous step differs from this one's previous step.
+/// For each record, whether it is a recalled state (module docs): equal to a turning state
+/// (the last step of an earlier phase) whose previous step differs from this one's previous
+/// step. The turning states are kept by load, without repeats, so a long constant-amplitude
+/// history costs a few comparisons per step.
 pub fn recalled_steps(records: &[StepRecord]) -> Vec<bool> {
-    (0..records.len())
-        .map(|k| {
-            k >= 2
-                && (1..k).any(|j| {
-                    records[j].phase != records[k].phase
+    use std::collections::HashMap;
+    let n = records.len();
+    let q_scale = records
+        .iter()
+        .map(|r| r.q.abs())
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE);
+    // Loads in bins of 1e−6 of the largest |Q|; a neighbour bin catches a load at an edge.
+    let bin = |q: f64| (q / q_scale * 1e6).round() as i64;
+    let mut turning: HashMap<i64, Vec<usize>> = HashMap::new();
+    let mut recalled = vec![false; n];
+    for k in 1..n {
+        let b = bin(records[k].q);
+        let matches = |j: usize| {
+            same_state(&records[j], &records[k]) && same_state(&records[j - 1], &records[k - 1])
+        };
+        recalled[k] = (b - 1..=b + 1).any(|b| {
+            turning.get(&b).is_some_and(|js| {
+                js.iter().any(|&j| {
+                    records[j].phase < records[k].phase
                         && same_state(&records[j], &records[k])
                         && !same_state(&records[j - 1], &records[k - 1])
                 })
-        })
-        .collect()
+            })
+        });
+        let last_of_phase = k + 1 == n || records[k + 1].phase != records[k].phase;
+        if last_of_phase && records[k].phase > 0 {
+            let js = turning.entry(b).or_default();
+            if !js.iter().any(|&j| matches(j)) {
+                js.push(k);
+            }
+        }
+    }
+    recalled
 }
 
 /// The loop plots: Q/(ηP) against δ, and against the slip displacement δ − C·Q when C is
@@ -327,6 +353,20 @@ mod tests {
         );
         assert!(svg.contains(r#"fill="darkorange""#));
         assert!(svg.contains("stick zone (|q| &lt; ηp)"));
+        // A long history (the default's records 1000 times over, 130,000 steps, each copy in
+        // later phases) costs a few comparisons per step, not one per earlier step.
+        let block = &records[1..];
+        let phases_per_block = block.last().unwrap().phase;
+        let long: Vec<StepRecord> = std::iter::once(records[0].clone())
+            .chain((0..1000).flat_map(|copy| {
+                block.iter().map(move |r| StepRecord {
+                    phase: r.phase + copy * phases_per_block,
+                    ..r.clone()
+                })
+            }))
+            .collect();
+        let flagged = recalled_steps(&long);
+        assert!(flagged[70] && flagged[110] && flagged.len() == 130_001);
         let plots = history_plots(&records, 1.0, false);
         let names: Vec<&str> = plots.iter().map(|(n, _)| n.as_str()).collect();
         assert_eq!(names, ["hysteresis", "hysteresis_slip", "stick_zone"]);
