@@ -247,7 +247,7 @@ fn hidden_ours(e: &str) -> bool {
         .any(|s| top.ends_with(s))
 }
 
-/// The names a sweep folder may hold: its manifest, index, CSV files, comparison plots, the
+/// The names a sweep folder may hold: its manifest, index, CSV files, plots, the
 /// variants' folders (each checked as a run folder when it is written) and fretsim's hidden
 /// staging, lock and temporary files.
 fn sweep_entry(e: &str) -> bool {
@@ -259,7 +259,18 @@ fn sweep_entry(e: &str) -> bool {
         || (e.starts_with("sweep-") && e.ends_with(".csv") && !e.contains('/'))
         || top.starts_with("variant_")
         || e == "plots/"
-        || (e.starts_with("plots/compare_") && e.ends_with(".svg"))
+        || sweep_plot(e)
+}
+
+/// A sweep's plot: `plots/{compare,sweep,map}_<name>.{svg,png}`.
+fn sweep_plot(e: &str) -> bool {
+    e.strip_prefix("plots/").is_some_and(|name| {
+        !name.contains('/')
+            && ["compare_", "sweep_", "map_"]
+                .iter()
+                .any(|p| name.starts_with(p))
+            && (name.ends_with(".svg") || name.ends_with(".png"))
+    })
 }
 
 /// Whether `dir` is a leftover of fretsim's own: a staging folder with its marker, or an

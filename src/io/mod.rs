@@ -6,18 +6,22 @@
 //! - [`mod@run`]: [`solve`] (a scenario's results, nothing written) and [`run()`] (solve, then write
 //!   the output folder);
 //! - [`summary`]: the contents of `summary.json`;
-//! - [`csv`], [`plots`], [`svg`]: the files of a run;
-//! - [`mod@sweep`]: `fretsim sweep`;
+//! - [`csv`], [`plots`], [`history_plots`], [`svg`]: the files of a run; [`png`]: the PNG
+//!   beside each SVG plot (resvg, embedded font);
+//! - [`mod@sweep`]: `fretsim sweep`, and its result plots and maps (`sweep_plots`);
 //! - [`folder`]: the output folder's rules: never touch what fretsim did not write, replace a
 //!   previous output atomically.
 
 pub mod csv;
 pub mod folder;
+pub mod history_plots;
 pub mod plots;
+pub mod png;
 pub mod run;
 pub mod summary;
 pub mod svg;
 pub mod sweep;
+mod sweep_plots;
 
 pub use run::{RunResult, Solution, run, run_with, solve};
 pub use sweep::{Shard, SweepOptions, SweepOutput, Vary, sweep};

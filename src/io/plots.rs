@@ -95,13 +95,89 @@ const QUANTITIES: [Quantity; 5] = [
     ),
 ];
 
+/// Where the contact and its stick zone end at one instant (m), marked on the field plots.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ZoneEnds {
+    /// Contact ends `(c − a, c + a)`.
+    pub contact: (f64, f64),
+    /// Stick-zone ends, `None` without friction.
+    pub stick: Option<(f64, f64)>,
+}
+
+impl ZoneEnds {
+    /// The ends of a contact state's contact and stick zone.
+    pub fn of(state: &crate::contact::ContactState) -> Self {
+        Self {
+            contact: (
+                state.centre - state.half_width,
+                state.centre + state.half_width,
+            ),
+            stick: state.traction.stick.as_ref().map(|z| (z.lo, z.hi)),
+        }
+    }
+}
+
+/// The marks of one curve's zone ends on a field plot whose x is divided by `x_scale`: the
+/// stick zone shaded (`shade`, a single curve) or its ends dashed in the curve's colour, and
+/// the contact ends dashed grey.
+fn zone_marks<'a>(
+    ends: &ZoneEnds,
+    x_scale: f64,
+    colour: &'a str,
+    shade: bool,
+    figure: &mut crate::io::svg::Figure<'a>,
+) {
+    use crate::io::svg::{Area, Marker};
+    let (c0, c1) = ends.contact;
+    // A family's contact ends that nearly coincide (within 1 % of a) are drawn once.
+    let tolerance = 1e-2 * 0.5 * (c1 - c0).abs() / x_scale;
+    for x in [c0, c1] {
+        let drawn = figure
+            .markers
+            .iter()
+            .any(|m| m.colour == "#777" && (m.x - x / x_scale).abs() <= tolerance);
+        if drawn {
+            continue;
+        }
+        figure.markers.push(Marker {
+            x: x / x_scale,
+            colour: "#777",
+            label: if shade { "contact ends" } else { "" },
+        });
+    }
+    if let Some((s0, s1)) = ends.stick {
+        if shade {
+            figure.areas.push(Area::band(
+                s0 / x_scale,
+                s1 / x_scale,
+                "#4a90d9",
+                0.15,
+                "stick zone",
+            ));
+        } else {
+            for x in [s0, s1] {
+                figure.markers.push(Marker {
+                    x: x / x_scale,
+                    colour,
+                    label: "",
+                });
+            }
+        }
+    }
+}
+
+/// The caption of a family's field plot: what its dashed lines mark.
+const FAMILY_CAPTION: &str =
+    "dashed: stick-zone ends (in the curve's colour) and contact ends (grey)";
+
 /// The plots of the fields at the end of normal loading: p and q together, then g, σxx0 and
-/// Dx0.
+/// Dx0, each with the contact ends (dashed) and the stick zone (shaded) marked.
 pub(crate) fn normal_loading_plots(
     points: &[SurfacePoint],
+    ends: &ZoneEnds,
     scales: &PlotScales,
 ) -> Vec<(String, String)> {
-    use crate::io::svg::{Series, line_plot};
+    use crate::io::svg::{Figure, Series};
     let (x_scale, x_label) = scales.x();
     let field = |f: fn(&SurfacePoint) -> f64, scale: f64| {
         points
@@ -116,26 +192,26 @@ pub(crate) fn normal_loading_plots(
         p_label
             .replacen("p/p0", "p/p0, q/p0", 1)
             .replacen("p (Pa)", "p, q (Pa)", 1);
-    let mut plots = vec![(
-        "normal_loading_tractions".to_string(),
-        line_plot(
-            "End of normal loading: pressure p and shear traction q",
-            &x_label,
-            &tractions_label,
-            &[
-                Series {
-                    label: "p",
-                    points: field(p.2, p_scale),
-                    colour: "black",
-                },
-                Series {
-                    label: "q (on the half-plane)",
-                    points: field(q.2, p_scale),
-                    colour: "crimson",
-                },
-            ],
-        ),
-    )];
+    let mut tractions = Figure {
+        title: "End of normal loading: pressure p and shear traction q".into(),
+        x_label: x_label.clone(),
+        y_label: tractions_label,
+        series: vec![
+            Series {
+                label: "p",
+                points: field(p.2, p_scale),
+                colour: "black",
+            },
+            Series {
+                label: "q (on the half-plane)",
+                points: field(q.2, p_scale),
+                colour: "crimson",
+            },
+        ],
+        ..Figure::default()
+    };
+    zone_marks(ends, x_scale, "black", true, &mut tractions);
+    let mut plots = vec![("normal_loading_tractions".to_string(), tractions.svg())];
     let names = [
         "normal_loading_charge",
         "normal_loading_sigma_xx",
@@ -143,145 +219,213 @@ pub(crate) fn normal_loading_plots(
     ];
     for ((_, title, f, scale), name) in rest.iter().zip(names) {
         let (s, label) = scale(scales);
-        plots.push((
-            name.to_string(),
-            line_plot(
-                &format!("End of normal loading: {}", title.to_lowercase()),
-                &x_label,
-                &label,
-                &[Series {
-                    label: "",
-                    points: field(*f, s),
-                    colour: "black",
-                }],
-            ),
-        ));
+        let mut figure = Figure {
+            title: format!("End of normal loading: {}", title.to_lowercase()),
+            x_label: x_label.clone(),
+            y_label: label,
+            series: vec![Series {
+                label: "",
+                points: field(*f, s),
+                colour: "black",
+            }],
+            ..Figure::default()
+        };
+        zone_marks(ends, x_scale, "black", true, &mut figure);
+        plots.push((name.to_string(), figure.svg()));
     }
     plots
 }
 
+/// One member of a family of field curves: legend label, samples and zone ends.
+pub type FamilyMember<'a> = (&'a str, &'a [SurfacePoint], ZoneEnds);
+
 /// One plot per field quantity (p, q, g, σxx0, Dx0) with one curve per member of a family
-/// (snapshot instants of a run, or variants of a sweep), named `<prefix>_<quantity>`. Empty
-/// when the family is empty.
+/// (snapshot instants of a run, or variants of a sweep), named `<prefix>_<quantity>`, each
+/// member's stick-zone ends dashed in its colour and its contact ends dashed grey (a single
+/// member: the stick zone shaded). Empty when the family is empty.
 pub fn family_plots(
     prefix: &str,
     what: &str,
-    family: &[(&str, &[SurfacePoint])],
+    family: &[FamilyMember<'_>],
     scales: &PlotScales,
 ) -> Vec<(String, String)> {
-    use crate::io::svg::{PALETTE, Series, line_plot};
+    use crate::io::svg::{Figure, PALETTE, Series};
     if family.is_empty() {
         return Vec::new();
     }
     let (x_scale, x_label) = scales.x();
+    let single = family.len() == 1;
     QUANTITIES
         .iter()
         .map(|(key, title, f, scale)| {
             let (s, y_label) = scale(scales);
-            let series: Vec<Series> = family
-                .iter()
-                .enumerate()
-                .map(|(k, (label, points))| Series {
+            let mut figure = Figure {
+                title: format!("{title} {what}"),
+                x_label: x_label.clone(),
+                y_label,
+                caption: if single {
+                    String::new()
+                } else {
+                    FAMILY_CAPTION.into()
+                },
+                ..Figure::default()
+            };
+            for (k, (label, points, ends)) in family.iter().enumerate() {
+                let colour = PALETTE[k % PALETTE.len()];
+                figure.series.push(Series {
                     label,
                     points: points.iter().map(|p| (p.x / x_scale, f(p) / s)).collect(),
-                    colour: PALETTE[k % PALETTE.len()],
-                })
-                .collect();
-            (
-                format!("{prefix}_{key}"),
-                line_plot(&format!("{title} {what}"), &x_label, &y_label, &series),
-            )
+                    colour,
+                });
+                zone_marks(ends, x_scale, colour, single, &mut figure);
+            }
+            (format!("{prefix}_{key}"), figure.svg())
         })
         .collect()
 }
 
-/// With a history (and at least one step after normal loading): the hysteresis loop and the
-/// stick-zone ends.
-pub(crate) fn history_plots(
-    records: &[crate::history::StepRecord],
-    limit: f64,
-    failed: bool,
-) -> Vec<(String, String)> {
-    use crate::io::svg::{Series, line_plot};
-    if records.len() <= 1 {
-        return Vec::new();
-    }
-    let note = if failed { " (stopped early)" } else { "" };
-    let loop_pts: Vec<(f64, f64)> = records
-        .iter()
-        .map(|r| (r.displacement, r.q / limit))
-        .collect();
-    let ends = |f: &dyn Fn(&crate::history::StepRecord) -> f64| {
-        records
-            .iter()
-            .map(|r| (r.t, f(r) / r.half_width))
-            .collect::<Vec<_>>()
-    };
-    vec![
-        (
-            "hysteresis".into(),
-            line_plot(
-                &format!("Fretting loop{note}"),
-                "tangential displacement δ (m)",
-                "Q/(ηP) (–)",
-                &[Series {
-                    label: "Q–δ",
-                    points: loop_pts,
-                    colour: "black",
-                }],
-            ),
-        ),
-        (
-            "stick_zone".into(),
-            line_plot(
-                &format!("Stick-zone ends and contact ends{note}"),
-                "time t (s)",
-                "x / a (–)",
-                &[
-                    Series {
-                        label: "stick-zone left end",
-                        points: ends(&|r| r.stick_lo),
-                        colour: "navy",
-                    },
-                    Series {
-                        label: "stick-zone right end",
-                        points: ends(&|r| r.stick_hi),
-                        colour: "crimson",
-                    },
-                    Series {
-                        label: "contact ends",
-                        points: ends(&|r| -r.eccentricity - r.half_width),
-                        colour: "gray",
-                    },
-                    Series {
-                        label: "",
-                        points: ends(&|r| -r.eccentricity + r.half_width),
-                        colour: "gray",
-                    },
-                ],
-            ),
-        ),
-    ]
-}
-
-/// `index.html`: every plot on one page, in sections, and links to every file.
+/// `index.html`: a contents list (a link to each section), then every plot on one page, in
+/// sections (each plot shown by its SVG, with a link to it), and links to
+/// every file.
 pub fn index_html(name: &str, sections: &[(String, Vec<String>)], files: &[String]) -> String {
     use crate::io::svg::escape;
     let name = escape(name);
+    let anchor = |k: usize| format!("section-{}", k + 1);
+    let mut contents = String::from("<nav><h2>Contents</h2>\n<ol>\n");
     let mut body = String::new();
-    for (title, plots) in sections {
-        body.push_str(&format!("<h2>{}</h2>\n", escape(title)));
+    for (k, (title, plots)) in sections.iter().enumerate() {
+        let title = escape(title);
+        contents.push_str(&format!(
+            "<li><a href=\"#{}\">{title}</a> ({} plot{})</li>\n",
+            anchor(k),
+            plots.len(),
+            if plots.len() == 1 { "" } else { "s" }
+        ));
+        body.push_str(&format!("<h2 id=\"{}\">{title}</h2>\n", anchor(k)));
         for p in plots {
             body.push_str(&format!(
-                "<figure><img src=\"plots/{p}.svg\" alt=\"{p}\"><figcaption>plots/{p}.svg</figcaption></figure>\n"
+                "<figure id=\"{p}\"><img src=\"plots/{p}.svg\" alt=\"{p}\" style=\"max-width:100%\"><figcaption><a href=\"plots/{p}.svg\">plots/{p}.svg</a></figcaption></figure>\n"
             ));
         }
     }
+    contents.push_str("<li><a href=\"#files\">Files</a></li>\n</ol></nav>\n");
     let links: String = files
         .iter()
         .map(|f| format!("<li><a href=\"{f}\">{f}</a></li>\n", f = escape(f)))
         .collect();
     format!(
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>fretsim: {name}</title></head>\n<body>\n<h1>fretsim: {name}</h1>\n<p>Columns and units of every file: see the fretsim README.</p>\n{body}<h2>Files</h2>\n<ul>\n{links}</ul>\n</body></html>\n"
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>fretsim: {name}</title></head>\n<body>\n<h1>fretsim: {name}</h1>\n<p>Columns and units of every file: see the fretsim README.</p>\n{contents}{body}<h2 id=\"files\">Files</h2>\n<ul>\n{links}</ul>\n</body></html>\n"
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn samples() -> Vec<SurfacePoint> {
+        (0..9)
+            .map(|k| {
+                let x = (k as f64 - 4.0) * 0.5e-5;
+                SurfacePoint {
+                    x,
+                    pressure: (1.0 - (x / 2e-5).powi(2)).max(0.0),
+                    traction: 0.1 * x,
+                    charge: 0.0,
+                    sigma_xx: -1.0,
+                    d_x: 0.0,
+                }
+            })
+            .collect()
+    }
+
+    const ENDS: ZoneEnds = ZoneEnds {
+        contact: (-2e-5, 2e-5),
+        stick: Some((-1.5e-5, 1e-5)),
+    };
+
+    /// p, q, g and σxx0 at the end of normal loading: the contact ends dashed at x/a = ±1 and
+    /// the stick zone shaded over [−0.75, 0.5] a, both in the legend.
+    #[test]
+    fn normal_loading_plots_mark_the_contact_ends_and_shade_the_stick_zone() {
+        let scales = PlotScales::normalised(2e-5, 1.0, 0.3, 0.0);
+        let plots = normal_loading_plots(&samples(), &ENDS, &scales);
+        assert_eq!(plots.len(), 4);
+        for (name, svg) in &plots {
+            assert_eq!(svg.matches(r#"class="marker""#).count(), 2, "{name}");
+            assert_eq!(svg.matches(r#"class="area""#).count(), 1, "{name}");
+            assert!(
+                svg.contains(">contact ends<") && svg.contains(">stick zone<"),
+                "{name}"
+            );
+        }
+        let svg = &plots[0].1;
+        let xs: Vec<f64> = svg
+            .split(r#"class="marker" x1=""#)
+            .skip(1)
+            .map(|s| s.split('"').next().unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(xs.len(), 2);
+        // x spans [−1, 1] (the samples): the markers at the plot area's edges.
+        assert!(
+            (xs[0] - 90.0).abs() < 0.01 && (xs[1] - 710.0).abs() < 0.01,
+            "{xs:?}"
+        );
+    }
+
+    /// A family marks each member's stick-zone ends dashed in its colour (no band) and the
+    /// contact ends that coincide once.
+    #[test]
+    fn family_plots_dash_each_members_stick_ends_and_shared_contact_ends_once() {
+        let points = samples();
+        let other = ZoneEnds {
+            contact: ENDS.contact,
+            stick: Some((-1e-5, 1.5e-5)),
+        };
+        let family: Vec<FamilyMember> = vec![("A", &points, ENDS), ("B", &points, other)];
+        let plots = family_plots("snapshots", "at t", &family, &PlotScales::SI);
+        assert_eq!(plots.len(), 5);
+        for (name, svg) in &plots {
+            assert_eq!(svg.matches(r#"class="area""#).count(), 0, "{name}");
+            assert_eq!(
+                svg.matches(r#"class="marker""#).count(),
+                2 + 2 + 2,
+                "{name}"
+            );
+            assert_eq!(svg.matches(r##"class="marker" x1"##).count(), 6);
+            assert!(svg.contains(crate::io::svg::PALETTE[1]));
+            assert!(svg.contains("dashed: stick-zone ends"));
+        }
+        // A single member is drawn like a normal-loading plot: the stick zone shaded.
+        let plots = family_plots("snapshots", "at t", &family[..1], &PlotScales::SI);
+        assert!(
+            plots
+                .iter()
+                .all(|(_, svg)| svg.matches(r#"class="area""#).count() == 1)
+        );
+    }
+
+    #[test]
+    fn the_page_opens_with_a_contents_list_of_its_sections() {
+        let sections = vec![
+            (
+                "Results against friction".to_string(),
+                vec!["sweep_b_over_a".to_string()],
+            ),
+            (
+                "Fields & more".to_string(),
+                vec!["a".to_string(), "b".to_string()],
+            ),
+        ];
+        let html = index_html("s", &sections, &["sweep.csv".to_string()]);
+        let contents = html.find("<h2>Contents</h2>").unwrap();
+        assert!(contents < html.find("<h2 id=\"section-1\">").unwrap());
+        assert!(
+            html.contains("<li><a href=\"#section-1\">Results against friction</a> (1 plot)</li>")
+        );
+        assert!(html.contains("<li><a href=\"#section-2\">Fields &amp; more</a> (2 plots)</li>"));
+        assert!(html.contains("<h2 id=\"section-2\">Fields &amp; more</h2>"));
+        assert!(
+            html.contains("<a href=\"#files\">Files</a>") && html.contains("<h2 id=\"files\">")
+        );
+    }
 }

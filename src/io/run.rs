@@ -12,7 +12,11 @@ use crate::error::Error;
 use crate::history::{RunOptions, SolvedState, SolverKind, StateView, StepRecord};
 use crate::io::csv::{cycles_table, fields_table, steps_table};
 use crate::io::folder::{Protected, RunFolder};
-use crate::io::plots::{PlotScales, family_plots, history_plots, index_html, normal_loading_plots};
+use crate::io::history_plots::history_plots;
+use crate::io::plots::{
+    FamilyMember, PlotScales, ZoneEnds, family_plots, index_html, normal_loading_plots,
+};
+use crate::io::png::plot_files;
 use crate::io::summary::{
     Handover, Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary,
     solver_statistics,
@@ -72,6 +76,8 @@ pub struct FieldSet {
     pub label: String,
     /// The samples.
     pub points: Vec<SurfacePoint>,
+    /// Where the contact and the stick zone end (marked on the plots).
+    pub ends: ZoneEnds,
 }
 
 /// Keeps, while the history runs, the states that the field files need: the turning points
@@ -245,6 +251,7 @@ pub fn solve(
         stem: "normal_loading".into(),
         label: "end of normal loading".into(),
         points: sample(&SolvedState::Spectral(Box::new(normal.state.clone()))),
+        ends: ZoneEnds::of(&normal.state),
     }];
     let (at_snapshots, snapshot_rows) = snapshot_fields(
         scenario,
@@ -277,6 +284,7 @@ pub fn solve(
                 stem: format!("step_{:05}", rec.step),
                 label: format!("step {}", rec.step),
                 points: sample(state),
+                ends: zone_ends(state, rec),
             });
         }
     }
@@ -288,6 +296,22 @@ pub fn solve(
         cycles,
         failure,
     })
+}
+
+/// The contact and stick-zone ends of a state, for the marks of its field plots: the
+/// spectral state's own, or the record's of an element state (its outermost contact elements
+/// and its longest stick run).
+fn zone_ends(state: &SolvedState, rec: &StepRecord) -> ZoneEnds {
+    match state {
+        SolvedState::Spectral(s) => ZoneEnds::of(s),
+        SolvedState::General(..) => ZoneEnds {
+            contact: (
+                -rec.eccentricity - rec.half_width,
+                -rec.eccentricity + rec.half_width,
+            ),
+            stick: Some((rec.stick_lo, rec.stick_hi)),
+        },
+    }
 }
 
 /// The warning for a normal-loading state that interpenetrates the punch just outside the
@@ -350,6 +374,7 @@ fn snapshot_fields(
             label: format!("t = {t} s, Q/(ηP) = {:.3}", rec.q / limit),
             stem: stem.clone(),
             points: sample(state),
+            ends: zone_ends(state, rec),
         });
         rows.push(SnapshotSummary {
             t,
@@ -404,8 +429,16 @@ pub(crate) fn write_solution(
         }
         let mut section = |title: &str, plots: Vec<(String, String)>| -> Result<(), Error> {
             let mut names = Vec::new();
-            for (name, svg) in plots {
-                put(format!("plots/{name}.svg"), svg.as_bytes())?;
+            use rayon::prelude::*;
+            // PNG rendering is the slow part: the plots of a section in parallel.
+            let files = plots
+                .par_iter()
+                .map(|(name, svg)| plot_files(name, svg, scenario.raw.output.png))
+                .collect::<Result<Vec<_>, Error>>()?;
+            for ((name, _), files) in plots.into_iter().zip(files) {
+                for (path, bytes) in files {
+                    put(path, &bytes)?;
+                }
                 names.push(name);
             }
             if !names.is_empty() {
@@ -415,15 +448,15 @@ pub(crate) fn write_solution(
         };
         section(
             "End of normal loading",
-            normal_loading_plots(&fields[0].points, &scales),
+            normal_loading_plots(&fields[0].points, &fields[0].ends, &scales),
         )?;
         section(
             "Load history",
             history_plots(records, limit, failure.is_some()),
         )?;
-        let instants: Vec<(&str, &[SurfacePoint])> = fields[1..]
+        let instants: Vec<FamilyMember> = fields[1..]
             .iter()
-            .map(|f| (f.label.as_str(), f.points.as_slice()))
+            .map(|f| (f.label.as_str(), f.points.as_slice(), f.ends))
             .collect();
         section(
             "Fields at the snapshot instants",

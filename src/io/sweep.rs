@@ -4,14 +4,14 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::contact::SurfacePoint;
 use crate::contact::normal::{NormalOptions, solve_normal};
 use crate::contact::pressure::Discretisation;
 use crate::error::Error;
 use crate::io::folder::{Protected, RunFolder, SweepFolder};
-use crate::io::plots::{PlotScales, family_plots, index_html};
+use crate::io::plots::{FamilyMember, PlotScales, family_plots, index_html};
 use crate::io::run::{FieldSet, run_partial};
 use crate::io::summary::{NormalSummary, normal_summary};
+use crate::io::sweep_plots::{ResultColumn, sweep_plots};
 use crate::scenario::Scenario;
 
 /// Most variants in a sweep (the product of the `--vary` counts).
@@ -562,8 +562,8 @@ pub fn sweep(
     }
     let csv_path = folder.dir().join(&name);
     crate::io::folder::write_atomic(&csv_path, &w.into_inner().expect("in-memory write"))?;
-    if options.runs && options.shard.is_none() {
-        write_comparison(vary, &scenarios, &outcomes, out_dir, &name)?;
+    if options.shard.is_none() {
+        write_pages(vary, &scenarios, &outcomes, out_dir, &name, options.runs)?;
     }
     Ok(SweepOutput {
         csv: csv_path,
@@ -579,15 +579,147 @@ pub fn sweep(
     })
 }
 
-/// The comparison plots of a sweep with runs: for the end of normal loading and each snapshot
-/// instant, p, q, g, σxx0 and Dx0 with one curve per variant; and the sweep's `index.html`.
-pub(crate) fn write_comparison(
+/// The numeric result columns of `sweep.csv` (the history's with runs), one value per
+/// variant, for the result plots.
+fn result_columns(outcomes: &[VariantOutcome], runs: bool) -> Vec<ResultColumn> {
+    type Normal = fn(&NormalSummary) -> f64;
+    let normal: [(&str, &str, Normal); 7] = [
+        ("a_m", "contact half-width a (m)", |n| n.half_width),
+        ("b_over_a", "stick ratio b/a (–)", |n| n.stick_ratio),
+        ("C_per_m", "C (1/m)", |n| n.strain_slope),
+        ("p0_Pa", "peak pressure p0 (Pa)", |n| n.peak_pressure),
+        ("charge_C_per_m", "charge Γ (C/m)", |n| n.charge),
+        ("potential_V", "potential φ0 (V)", |n| {
+            n.potential.unwrap_or(f64::NAN)
+        }),
+        ("slip_sign_right", "slip sign, right zone (–)", |n| {
+            n.right_slip_sign
+        }),
+    ];
+    let mut columns: Vec<ResultColumn> = normal
+        .iter()
+        .map(|(name, label, f)| ResultColumn {
+            name,
+            label,
+            values: outcomes
+                .iter()
+                .map(|o| o.normal.as_ref().map_or(f64::NAN, f))
+                .collect(),
+        })
+        .collect();
+    if runs {
+        type History = fn(&HistoryColumns) -> f64;
+        let history: [(&str, &str, History); 4] = [
+            ("steps", "steps (–)", |h| h.steps as f64),
+            ("cycles", "cycles (–)", |h| h.cycles as f64),
+            (
+                "friction_work_last_cycle_J_per_m",
+                "friction work of the last cycle (J/m)",
+                |h| h.friction_work,
+            ),
+            (
+                "delta_amplitude_last_cycle_m",
+                "δ amplitude of the last cycle (m)",
+                |h| h.displacement_amplitude,
+            ),
+        ];
+        columns.extend(history.iter().map(|(name, label, f)| {
+            ResultColumn {
+                name,
+                label,
+                values: outcomes
+                    .iter()
+                    .map(|o| o.history.as_ref().map_or(f64::NAN, f))
+                    .collect(),
+            }
+        }));
+    }
+    columns
+}
+
+/// A sweep's pages: the plots of its scalar results (one varied field: against it; two: maps),
+/// with runs the comparison plots of the fields, and `index.html`, which opens with a
+/// contents list.
+pub(crate) fn write_pages(
     vary: &[Vary],
     scenarios: &[(usize, Vec<f64>, Scenario)],
     outcomes: &[VariantOutcome],
     out_dir: &Path,
     csv_name: &str,
+    runs: bool,
 ) -> Result<(), Error> {
+    // PNG files as the scenario asks (the variants share the output options).
+    let png = scenarios.first().is_none_or(|(_, _, sc)| sc.raw.output.png);
+    let write = |plots: Vec<(String, String)>| -> Result<Vec<String>, Error> {
+        use rayon::prelude::*;
+        let files = plots
+            .par_iter()
+            .map(|(name, svg)| crate::io::png::plot_files(name, svg, png))
+            .collect::<Result<Vec<_>, Error>>()?;
+        for (path, bytes) in files.into_iter().flatten() {
+            crate::io::folder::write_atomic(&out_dir.join(path), &bytes)?;
+        }
+        Ok(plots.into_iter().map(|(name, _)| name).collect())
+    };
+    let fields: Vec<&str> = vary.iter().map(|v| v.path.as_str()).collect();
+    let axes: Vec<Vec<f64>> = vary.iter().map(|v| v.values.clone()).collect();
+    let values: Vec<Vec<f64>> = scenarios.iter().map(|(_, v, _)| v.clone()).collect();
+    let verdicts: Option<Vec<String>> = runs.then(|| {
+        outcomes
+            .iter()
+            .map(|o| match (&o.error, &o.history) {
+                (Some(_), _) => "failed".to_string(),
+                (None, Some(h)) => h.verdict.clone(),
+                (None, None) => "no history".to_string(),
+            })
+            .collect()
+    });
+    let results = sweep_plots(
+        &fields,
+        &axes,
+        &values,
+        &result_columns(outcomes, runs),
+        verdicts.as_deref(),
+    );
+    let title = match fields.as_slice() {
+        [f] => format!("Results against {f}"),
+        [f0, f1] => format!("Maps over {f0} × {f1}"),
+        _ => String::new(),
+    };
+    let mut sections = Vec::new();
+    let names = write(results)?;
+    if !names.is_empty() {
+        sections.push((title, names));
+    }
+    if runs {
+        sections.extend(comparison_plots(vary, scenarios, outcomes, &write)?);
+    }
+    let mut files = vec![csv_name.to_string()];
+    if runs {
+        files.extend(
+            scenarios
+                .iter()
+                .map(|(i, _, _)| format!("{}/index.html", variant_dir(*i))),
+        );
+    }
+    let name = scenarios
+        .first()
+        .map_or("sweep", |(_, _, sc)| sc.name.as_str());
+    crate::io::folder::write_atomic(
+        &out_dir.join("index.html"),
+        index_html(&format!("{name} (sweep)"), &sections, &files).as_bytes(),
+    )
+}
+
+/// The comparison plots of a sweep with runs, written by `write`: for the end of normal
+/// loading and each snapshot instant, p, q, g, σxx0 and Dx0 with one curve per variant; one
+/// page section per instant.
+fn comparison_plots(
+    vary: &[Vary],
+    scenarios: &[(usize, Vec<f64>, Scenario)],
+    outcomes: &[VariantOutcome],
+    write: &dyn Fn(Vec<(String, String)>) -> Result<Vec<String>, Error>,
+) -> Result<Vec<(String, Vec<String>)>, Error> {
     let labels: Vec<String> = scenarios
         .iter()
         .map(|(_, values, _)| variant_label(vary, values))
@@ -602,12 +734,12 @@ pub(crate) fn write_comparison(
     }
     let mut sections = Vec::new();
     for stem in &stems {
-        let family: Vec<(&str, &[SurfacePoint])> = labels
+        let family: Vec<FamilyMember> = labels
             .iter()
             .zip(outcomes)
             .filter_map(|(label, o)| {
                 let set = o.fields.iter().find(|f| &f.stem == stem)?;
-                Some((label.as_str(), set.points.as_slice()))
+                Some((label.as_str(), set.points.as_slice(), set.ends))
             })
             .collect();
         let what = match scenarios.first() {
@@ -624,29 +756,10 @@ pub(crate) fn write_comparison(
         };
         // Variants differ in a and p0: their fields are compared in SI units.
         let plots = family_plots(&format!("compare_{stem}"), &what, &family, &PlotScales::SI);
-        let mut names = Vec::new();
-        for (name, svg) in plots {
-            crate::io::folder::write_atomic(
-                &out_dir.join("plots").join(format!("{name}.svg")),
-                svg.as_bytes(),
-            )?;
-            names.push(name);
-        }
+        let names = write(plots)?;
         if !names.is_empty() {
             sections.push((format!("Fields {what}, by variant"), names));
         }
     }
-    let mut files = vec![csv_name.to_string()];
-    files.extend(
-        scenarios
-            .iter()
-            .map(|(i, _, _)| format!("{}/index.html", variant_dir(*i))),
-    );
-    let name = scenarios
-        .first()
-        .map_or("sweep", |(_, _, sc)| sc.name.as_str());
-    crate::io::folder::write_atomic(
-        &out_dir.join("index.html"),
-        index_html(&format!("{name} (sweep)"), &sections, &files).as_bytes(),
-    )
+    Ok(sections)
 }

@@ -58,6 +58,10 @@ pub struct RawOutput {
     /// loading; the default) or `si`.
     #[serde(default)]
     pub plot_units: PlotUnits,
+    /// Also write each plot as a PNG beside its SVG (`plots/<name>.png`, 300 dpi at the plot's
+    /// nominal size; default true).
+    #[serde(default = "default_true")]
+    pub png: bool,
 }
 
 /// Which turning points get field files (`output.turning_point_fields`).
@@ -115,8 +119,13 @@ impl Default for RawOutput {
             turning_point_fields: TurningFields::default(),
             field_points: default_field_points(),
             plot_units: PlotUnits::default(),
+            png: true,
         }
     }
+}
+
+pub(super) fn default_true() -> bool {
+    true
 }
 
 pub(super) fn default_field_points() -> usize {

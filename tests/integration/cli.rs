@@ -228,6 +228,39 @@ fn assert_svg(path: &Path, curves: usize) {
     );
 }
 
+/// Every SVG plot in `dir` has its PNG beside it, which decodes at 300 dpi of the SVG's size
+/// (96 px per inch: 3.125 × its width and height).
+pub(crate) fn assert_pngs(dir: &Path) {
+    let mut svgs = 0;
+    for e in std::fs::read_dir(dir).unwrap() {
+        let path = e.unwrap().path();
+        if path.extension().is_none_or(|x| x != "svg") {
+            continue;
+        }
+        svgs += 1;
+        let svg = std::fs::read_to_string(&path).unwrap();
+        let size = |key: &str| -> u32 {
+            let at = svg.find(&format!(" {key}=\"")).unwrap() + key.len() + 3;
+            let v: f64 = svg[at..].split('"').next().unwrap().parse().unwrap();
+            (v * 300.0 / 96.0).round() as u32
+        };
+        let png = std::fs::read(path.with_extension("png"))
+            .unwrap_or_else(|e| panic!("{}: no PNG: {e}", path.display()));
+        let pixmap = resvg::tiny_skia::Pixmap::decode_png(&png).unwrap();
+        assert_eq!(
+            (pixmap.width(), pixmap.height()),
+            (size("width"), size("height")),
+            "{}",
+            path.display()
+        );
+        assert_eq!(
+            fretsim::io::png::png_size(&png),
+            Some((pixmap.width(), pixmap.height()))
+        );
+    }
+    assert!(svgs > 0, "{}: no plots", dir.display());
+}
+
 /// Run `scenario` into a fresh temporary folder and check what every run must write: exit 0,
 /// `summary.json` (strict), the field files with their header and row count, the CSV headers,
 /// the plots (one curve per snapshot instant) and `index.html` linking every plot.
@@ -268,6 +301,7 @@ fn run_checked(scenario: &Path) -> (tempfile::TempDir, PathBuf, Summary) {
         assert!(index.contains(file), "index.html lists {file}");
     };
     check_fields("fields/normal_loading.csv");
+    assert_pngs(&out.join("plots"));
     for plot in [
         "normal_loading_tractions",
         "normal_loading_charge",
@@ -291,8 +325,12 @@ fn run_checked(scenario: &Path) -> (tempfile::TempDir, PathBuf, Summary) {
             assert_eq!(header, CYCLES_HEADER);
             assert_eq!(rows.len(), h.cycles.len());
             assert_svg(&out.join("plots/hysteresis.svg"), 1);
-            assert_svg(&out.join("plots/stick_zone.svg"), 4);
-            for p in ["hysteresis", "stick_zone"] {
+            assert_svg(&out.join("plots/hysteresis_slip.svg"), 1);
+            // The zones as bands: the contact and a stick band per phase, no lines.
+            assert_svg(&out.join("plots/stick_zone.svg"), 0);
+            let zones = std::fs::read_to_string(out.join("plots/stick_zone.svg")).unwrap();
+            assert!(zones.matches(r#"class="area""#).count() >= 2);
+            for p in ["hysteresis", "hysteresis_slip", "stick_zone"] {
                 assert!(index.contains(&format!("plots/{p}.svg")));
             }
             // Turning-point fields, unless switched off.
@@ -638,10 +676,13 @@ fn default_run_reports_the_paper_baseline_and_the_interpenetration_warning() {
         "normal_loading_charge",
     ] {
         let svg = std::fs::read_to_string(out.join(format!("plots/{plot}.svg"))).unwrap();
-        assert!(
-            svg.starts_with("<svg") && svg.contains("<polyline"),
-            "{plot}"
-        );
+        // The zone plot draws bands, the others curves.
+        let drawn = if plot == "stick_zone" {
+            r#"class="area""#
+        } else {
+            "<polyline"
+        };
+        assert!(svg.starts_with("<svg") && svg.contains(drawn), "{plot}");
     }
     assert!(
         std::fs::read_to_string(out.join("index.html"))
@@ -988,6 +1029,78 @@ fn sweep_with_runs_keeps_each_variant_and_compares_the_fields() {
     }
     let svg = std::fs::read_to_string(out.join("plots/compare_t_1.000000_q.svg")).unwrap();
     assert!(svg.contains("friction = 0.2") && svg.contains("friction = 0.3"));
+    // Each scalar result against the varied field, the history's too; the page opens with
+    // its contents.
+    // (The short history has no full cycle: the last cycle's columns are empty, not plotted.)
+    for column in ["b_over_a", "C_per_m", "steps"] {
+        let name = format!("plots/sweep_{column}.svg");
+        assert!(index.contains(&name), "{name}");
+        let svg = std::fs::read_to_string(out.join(&name)).unwrap();
+        assert_eq!(svg.matches("<circle").count(), 2, "{name}");
+    }
+    assert_pngs(&out.join("plots"));
+    let contents = index.find("<h2>Contents</h2>").unwrap();
+    assert!(
+        contents
+            < index
+                .find("<h2 id=\"section-1\">Results against friction</h2>")
+                .unwrap()
+    );
+    assert!(index.contains("<a href=\"#section-1\">Results against friction</a>"));
+    assert!(index.contains("Fields at the end of normal loading, by variant</a>"));
+}
+
+/// Two varied fields: a map per scalar result and, with runs, a map of the verdict; without
+/// runs no verdict map. `output.png = false` writes no PNG.
+#[test]
+fn sweep_over_two_fields_draws_maps() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("short.json");
+    std::fs::write(
+        &file,
+        short_history("[]", ", \"field_points\": 40, \"png\": false"),
+    )
+    .unwrap();
+    for runs in [false, true] {
+        let out = tmp.path().join(format!("sw{runs}"));
+        let mut cmd = fretsim();
+        cmd.arg("sweep").arg(&file).args([
+            "--quiet",
+            "--vary",
+            "friction=0.3:0.4:2",
+            "--vary",
+            "normal_load=2000:2500:2",
+            "--out",
+        ]);
+        cmd.arg(&out);
+        if runs {
+            cmd.arg("--runs");
+        }
+        let o = cmd.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+        assert!(index.contains("Maps over friction × normal_load"));
+        let map = std::fs::read_to_string(out.join("plots/map_b_over_a.svg")).unwrap();
+        assert_eq!(map.matches(r#"class="area""#).count(), 4);
+        assert_eq!(out.join("plots/map_verdict.svg").exists(), runs);
+        assert_eq!(out.join("plots/map_steps.svg").exists(), runs);
+        // No full cycle in the short history: no map of the last cycle's friction work.
+        assert!(
+            !out.join("plots/map_friction_work_last_cycle_J_per_m.svg")
+                .exists()
+        );
+        let pngs = std::fs::read_dir(out.join("plots"))
+            .unwrap()
+            .filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .path()
+                    .extension()
+                    .is_some_and(|x| x == "png")
+            })
+            .count();
+        assert_eq!(pngs, 0, "output.png = false");
+    }
 }
 
 /// A history the solver cannot finish: the Figure-3 history at η = 0.1 (M = 64), whose first
