@@ -228,6 +228,18 @@ fn assert_svg(path: &Path, curves: usize) {
     );
 }
 
+/// No PNG in `dir` (`output.png` is off by default).
+fn assert_no_pngs(dir: &Path) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let path = e.unwrap().path();
+        assert!(
+            path.extension().is_none_or(|x| x != "png"),
+            "{}",
+            path.display()
+        );
+    }
+}
+
 /// Every SVG plot in `dir` has its PNG beside it, which decodes at 300 dpi of the SVG's size
 /// (96 px per inch: 3.125 × its width and height).
 pub(crate) fn assert_pngs(dir: &Path) {
@@ -301,7 +313,11 @@ fn run_checked(scenario: &Path) -> (tempfile::TempDir, PathBuf, Summary) {
         assert!(index.contains(file), "index.html lists {file}");
     };
     check_fields("fields/normal_loading.csv");
-    assert_pngs(&out.join("plots"));
+    if raw["output"]["png"] == serde_json::json!(true) {
+        assert_pngs(&out.join("plots"));
+    } else {
+        assert_no_pngs(&out.join("plots"));
+    }
     for plot in [
         "normal_loading_tractions",
         "normal_loading_charge",
@@ -998,7 +1014,11 @@ fn sweep_writes_one_row_per_variant_and_shards_split_them() {
 fn sweep_with_runs_keeps_each_variant_and_compares_the_fields() {
     let tmp = tempfile::tempdir().unwrap();
     let file = tmp.path().join("short.json");
-    std::fs::write(&file, short_history("[1.0]", ", \"field_points\": 40")).unwrap();
+    std::fs::write(
+        &file,
+        short_history("[1.0]", ", \"field_points\": 40, \"png\": true"),
+    )
+    .unwrap();
     let out = tmp.path().join("sw");
     let o = fretsim()
         .arg("sweep")
