@@ -24,6 +24,17 @@
 //! [`continue_run`] does the same from any driver state, and [`advance`] does it
 //! sequentially. The records are the same either way.
 //!
+//! # Two solvers
+//! [`continue_run`] hands a step that the spectral solver cannot take (it fails, or could only
+//! accept it at a stalled residual) to the general element solver ([`GeneralRun`], from the
+//! last committed state), which keeps the following steps until the spectral solver, trying
+//! each load from its own memory within the phase of the handover, agrees with it (same zone
+//! structure, ends within two elements); the spectral solver then commits that state with its
+//! own increments. Under [`SolverChoice::Auto`] the general solver also takes the first step
+//! of every phase, where thin end zones that slip the old way form in a coupled contact, and
+//! the spectral solver's step is handed over when the two disagree. Each record says which
+//! solver took the step ([`SolverKind`]) and the zone structure ([`ZoneCount`]).
+//!
 //! # Warm start
 //! Inside a phase the geometry of the step (stick ends, contact half-width and centre) is
 //! extrapolated from the last three steps by the quadratic in Q through them (`predict`), and

@@ -89,10 +89,10 @@ pub fn run_history(
 /// Walk the load points `points` from `driver` as [`run_history`] does, pushing a record per
 /// step onto `records` (the observer sees each), and return the first failure, if any.
 ///
-/// The spectral solver takes the steps while it can ([`spectral_stretch`]). Unless the
+/// The spectral solver takes the steps while it can (`spectral_stretch`). Unless the
 /// choice is [`SolverChoice::Spectral`], a step it fails is taken by the general solver,
 /// from the last committed state ([`GeneralRun::handover`]), and so are the steps after it
-/// until the spectral solver can take one again ([`resumes`]); [`SolverChoice::General`]
+/// until the spectral solver can take one again (`resumes`); [`SolverChoice::General`]
 /// hands over at the first step. The driver is left at the last state the spectral solver
 /// committed.
 pub fn continue_run(
