@@ -1108,6 +1108,11 @@ fn table(out: &mut String, title: &str, rows: &[Row], key: impl Fn(&Row) -> Stri
     }
 }
 
+/// Text for a Markdown table cell (`|q|` would end the cell).
+fn cell(text: &str) -> String {
+    text.replace('|', "\\|")
+}
+
 /// `summary.md` from `results.csv` and `rejected.csv`.
 fn summarise(dir: &Path) {
     let rows: Vec<Row> = read_rows(&dir.join("results.csv"));
@@ -1162,10 +1167,11 @@ fn summarise(dir: &Path) {
     for (k, list) in &failures {
         let _ = writeln!(
             out,
-            "| {k} | {} | `{}`: {} |",
+            "| {} | {} | `{}`: {} |",
+            cell(k),
             list.len(),
             list[0].id,
-            list[0].auto_failure.replace('|', "/")
+            cell(&list[0].auto_failure)
         );
     }
     // Spectral-only failures, by message.
@@ -1183,7 +1189,7 @@ fn summarise(dir: &Path) {
         "\n## Runs the spectral solver alone did not complete\n\n| status: failure | runs |\n|---|---|"
     );
     for (k, n) in &spectral {
-        let _ = writeln!(out, "| {k} | {n} |");
+        let _ = writeln!(out, "| {} | {n} |", cell(k));
     }
     // Takeovers.
     let taken: Vec<&Row> = rows.iter().filter(|r| r.general_steps > 0).collect();
@@ -1219,7 +1225,7 @@ fn summarise(dir: &Path) {
         "\n| handover reason | handovers | runs |\n|---|---|---|"
     );
     for (reason, (n, ids)) in &why {
-        let _ = writeln!(out, "| {reason} | {n} | {} |", ids.len());
+        let _ = writeln!(out, "| {} | {n} | {} |", cell(reason), ids.len());
     }
     let mut steps_hist: BTreeMap<usize, usize> = BTreeMap::new();
     for r in &taken {
@@ -1266,7 +1272,7 @@ fn summarise(dir: &Path) {
             "\n## Rejected by the validator\n\n| id | issues |\n|---|---|"
         );
         for r in &rejected {
-            let _ = writeln!(out, "| `{}` | {} |", r.id, r.issues.replace('|', "/"));
+            let _ = writeln!(out, "| `{}` | {} |", r.id, cell(&r.issues));
         }
     }
     let path = dir.join("summary.md");
