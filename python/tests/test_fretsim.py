@@ -36,7 +36,7 @@ def test_steps_and_fields_equal_the_command_lines_files(tmp_path):
     assert list(result.steps) == header
     for k, name in enumerate(header):
         column = [r[k] for r in rows]
-        if name == "regime":
+        if name in ("regime", "solver"):
             assert list(result.steps[name]) == column
         else:
             np.testing.assert_allclose(result.steps[name], np.array(column, float), rtol=1e-9)
