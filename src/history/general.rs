@@ -45,7 +45,7 @@ pub const END_SIZE: f64 = 5e-4;
 /// Element size at the stick ends of the handed-over state, relative to a.
 pub const STICK_SIZE: f64 = 1e-3;
 /// Growth of the element size per element away from the contact ends.
-pub const GROWTH: f64 = 1.06;
+pub const GROWTH: f64 = 1.08;
 /// Largest element, relative to a, by default (`numerics.general_element_size`).
 pub const INNER_SIZE: f64 = 6e-3;
 
