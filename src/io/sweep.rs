@@ -379,8 +379,9 @@ pub(crate) struct VariantOutcome {
     history: Option<HistoryColumns>,
 }
 
-/// A variant's history in `sweep.csv` (sweeps with runs): steps, cycles, the verdict and the
-/// last full cycle's friction work and displacement amplitude.
+/// A variant's history in `sweep.csv` (sweeps with runs): steps, cycles, the verdict, the
+/// last full cycle's friction work and displacement amplitude, and the steps the general
+/// solver took.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct HistoryColumns {
     steps: usize,
@@ -388,15 +389,17 @@ pub(crate) struct HistoryColumns {
     verdict: String,
     friction_work: f64,
     displacement_amplitude: f64,
+    general_steps: usize,
 }
 
 impl HistoryColumns {
-    const HEADER: [&'static str; 5] = [
+    const HEADER: [&'static str; 6] = [
         "steps",
         "cycles",
         "verdict",
         "friction_work_last_cycle_J_per_m",
         "delta_amplitude_last_cycle_m",
+        "general_steps",
     ];
 
     fn of(summary: &crate::io::summary::Summary) -> Option<Self> {
@@ -414,6 +417,7 @@ impl HistoryColumns {
             displacement_amplitude: last.map_or(f64::NAN, |c| {
                 0.5 * (c.displacement_extremes.0 - c.displacement_extremes.1)
             }),
+            general_steps: summary.solver.general_steps,
         })
     }
 
@@ -425,6 +429,7 @@ impl HistoryColumns {
                 h.verdict.clone(),
                 format!("{:.10e}", h.friction_work),
                 format!("{:.10e}", h.displacement_amplitude),
+                h.general_steps.to_string(),
             ],
             None => vec![String::new(); Self::HEADER.len()],
         }
@@ -609,7 +614,7 @@ fn result_columns(outcomes: &[VariantOutcome], runs: bool) -> Vec<ResultColumn> 
         .collect();
     if runs {
         type History = fn(&HistoryColumns) -> f64;
-        let history: [(&str, &str, History); 4] = [
+        let history: [(&str, &str, History); 5] = [
             ("steps", "steps (–)", |h| h.steps as f64),
             ("cycles", "cycles (–)", |h| h.cycles as f64),
             (
@@ -622,6 +627,9 @@ fn result_columns(outcomes: &[VariantOutcome], runs: bool) -> Vec<ResultColumn> 
                 "δ amplitude of the last cycle (m)",
                 |h| h.displacement_amplitude,
             ),
+            ("general_steps", "steps of the general solver (–)", |h| {
+                h.general_steps as f64
+            }),
         ];
         columns.extend(history.iter().map(|(name, label, f)| {
             ResultColumn {

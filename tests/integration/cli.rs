@@ -1324,6 +1324,8 @@ fn sweep_with_runs_reports_each_variants_history() {
         assert!((work - last[7]).abs() <= 1e-9 * last[7].abs());
         let amplitude: f64 = cells[col("delta_amplitude_last_cycle_m")].parse().unwrap();
         assert!((amplitude - 0.5 * (last[10] - last[11])).abs() <= 1e-9 * amplitude.abs());
+        let general: usize = cells[col("general_steps")].parse().unwrap();
+        assert_eq!(general, s.solver.general_steps);
         assert_eq!(*header.last().unwrap(), "error");
     }
 }
