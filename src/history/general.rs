@@ -153,9 +153,35 @@ pub struct ZoneCount {
 impl ZoneCount {
     /// The zones of an element state.
     pub fn of_elements(state: &GeneralState) -> Self {
+        Self::of_zones(state.zones().into_iter().map(|z| z.0))
+    }
+
+    /// The zones of an element state at its resolution: a zone of one element (a layer that
+    /// may be thinner than an element) is not counted, and its neighbours of one kind join.
+    pub fn resolved(state: &GeneralState) -> Self {
+        let mut codes: Vec<ElementState> = Vec::new();
+        let mut run = (ElementState::Exterior, 0usize);
+        let flush = |run: (ElementState, usize), codes: &mut Vec<ElementState>| {
+            if run.1 > 1 && codes.last() != Some(&run.0) {
+                codes.push(run.0);
+            }
+        };
+        for &code in &state.codes {
+            if code == run.0 {
+                run.1 += 1;
+            } else {
+                flush(run, &mut codes);
+                run = (code, 1);
+            }
+        }
+        flush(run, &mut codes);
+        Self::of_zones(codes.into_iter())
+    }
+
+    fn of_zones(zones: impl Iterator<Item = ElementState>) -> Self {
         let mut count = Self::default();
         let mut last_slip: Option<ElementState> = None;
-        for (code, _, _) in state.zones() {
+        for code in zones {
             match code {
                 ElementState::Exterior => {}
                 ElementState::Stick => count.stick += 1,

@@ -11,7 +11,7 @@ use crate::contact::tangential::SlipOptions;
 use super::driver::{
     DriverState, Solved, SolvedStep, finish_step, hold_record, record, solve_step,
 };
-use super::general::{GeneralRun, RunOptions, SolverChoice};
+use super::general::{GeneralRun, RunOptions, SolverChoice, ZoneCount};
 use super::increments::{IncrementInputs, StepIncrements};
 use super::load::{LoadHistory, LoadPoint};
 use super::record::{NoObserver, Observer, StateView, StepFailure, StepRecord};
@@ -315,10 +315,11 @@ fn spectral_stretch(
 }
 
 /// Whether the general solver's record of a step and the spectral solver's describe one state:
-/// the same zone structure and phase, and the contact and stick ends within two elements of
-/// the general solver's mesh there.
+/// the same phase, the same zone structure at the element resolution (a zone of one element is
+/// not a contradiction: [`ZoneCount::resolved`]), and the contact and stick ends within two
+/// elements of the general solver's mesh there.
 fn agrees(run: &GeneralRun, general: &StepRecord, spectral: &StepRecord) -> bool {
-    if spectral.zones != general.zones || spectral.phase != general.phase {
+    if spectral.zones != ZoneCount::resolved(&run.state) || spectral.phase != general.phase {
         return false;
     }
     let ends = |r: &StepRecord| {
