@@ -46,8 +46,7 @@ impl Solver {
         let n = mesh.len();
         let (c, a) = (state.centre, state.half_width);
         let (nodes, weights) = gauss_legendre(POINTS);
-        let conducting = self.coefficients.electric.is_some()
-            && !matches!(self.electric_control(loads), super::ElectricControl::None);
+        let conducting = !matches!(self.electric_control(loads), super::ElectricControl::None);
         let mut pressure = vec![0.0; n];
         let mut shear = vec![0.0; n];
         let mut charge = vec![0.0; n];
