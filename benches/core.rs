@@ -8,8 +8,8 @@ use fretsim::contact::normal::{NormalOptions, solve_normal};
 use fretsim::contact::pressure::Discretisation;
 use fretsim::contact::tangential::SlipOptions;
 use fretsim::history::{
-    DriverState, LoadHistory, LoadPoint, NoObserver, RunOptions, StepRecord, advance, continue_run,
-    run_history, solve_step,
+    DriverState, HistoryState, LoadHistory, LoadPoint, NoObserver, RunOptions, StepRecord, advance,
+    continue_run, run_history, solve_step,
 };
 use fretsim::scenario::{Scenario, default_scenario};
 
@@ -200,10 +200,11 @@ fn steps_in_a_run(c: &mut Criterion) {
                         let mut d = driver.clone();
                         if pipelined {
                             let mut records = Vec::new();
+                            let mut state = HistoryState::new(d);
                             let failure = continue_run(
                                 &sc.model,
                                 &disc,
-                                &mut d,
+                                &mut state,
                                 &points,
                                 RunOptions::default(),
                                 &mut NoObserver,

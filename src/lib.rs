@@ -83,6 +83,7 @@ pub mod io;
 pub mod material;
 pub mod quadrature;
 pub mod scenario;
+mod shared;
 pub mod transforms;
 
 // The entry points most programs need, at the crate root.

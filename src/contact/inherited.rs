@@ -13,16 +13,58 @@ use super::stick_zone::FADE_TABLE_REUSE;
 /// `ramp_lo.1` and falling from 1 at `ramp_hi.0` to 0 at `ramp_hi.1` (C² quintic ramps).
 /// The memory inside the new zone has square-root kinks at the old zone's ends, which the old
 /// correction reproduces exactly; the fade only matters near the new ends, where q̃ must vanish.
-#[derive(Debug, Clone)]
+///
+/// Written as plain data: the fade table as the ramps its nodes were built for (its own, or
+/// those of the link it was taken from, [`Inherited::reusing_table_of`]), rebuilt on reading.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+#[serde(from = "InheritedData")]
 pub struct Inherited {
     /// The earlier zone (with its own chain).
+    #[serde(with = "crate::shared")]
     pub zone: std::sync::Arc<StickZone>,
     /// Left ramp `(start, end)`, or `None` when the earlier zone lies inside on that side.
     pub ramp_lo: Option<(f64, f64)>,
     /// Right ramp `(start, end)`.
     pub ramp_hi: Option<(f64, f64)>,
     /// Quadrature table of the fade integral, built on first use.
+    #[serde(serialize_with = "table_ramps")]
     table: std::sync::OnceLock<FadeTable>,
+}
+
+/// The ramps a built fade table's nodes were placed for (`None` when not built).
+fn table_ramps<S: serde::Serializer>(
+    table: &std::sync::OnceLock<FadeTable>,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    serde::Serialize::serialize(&table.get().map(|t| t.ramps), serializer)
+}
+
+/// An [`Inherited`] as written.
+#[derive(serde::Deserialize)]
+struct InheritedData {
+    #[serde(with = "crate::shared")]
+    zone: std::sync::Arc<StickZone>,
+    ramp_lo: Option<(f64, f64)>,
+    ramp_hi: Option<(f64, f64)>,
+    table: Option<[Option<(f64, f64)>; 2]>,
+}
+
+impl From<InheritedData> for Inherited {
+    fn from(d: InheritedData) -> Self {
+        let link = Self::new(d.zone, d.ramp_lo, d.ramp_hi);
+        match d.table {
+            None => link,
+            Some([lo, hi]) if lo == link.ramp_lo && hi == link.ramp_hi => {
+                link.table();
+                link
+            }
+            Some([lo, hi]) => {
+                let built = Self::new(link.zone.clone(), lo, hi);
+                built.table();
+                link.with_nodes_of(&built)
+            }
+        }
+    }
 }
 
 /// Quadrature nodes `(t, w q̃_E(t), χ(t))` of the fade integral of an [`Inherited`], all of
@@ -331,6 +373,12 @@ impl Inherited {
         {
             return self;
         }
+        self.with_nodes_of(built)
+    }
+
+    /// This link with the nodes and `w q̃_E` of `built`'s fade table, which must be built.
+    fn with_nodes_of(self, built: &Inherited) -> Self {
+        let table = built.table.get().expect("a built table");
         let all = table
             .all
             .iter()

@@ -38,7 +38,7 @@ pub fn kink_cauchy(u: f64) -> f64 {
 /// one at the contact end and has a Cauchy transform in closed form ([`half_ellipse_cauchy`]).
 /// See the tangential module docs ("Kinks at the stick ends") for where the kinks come from
 /// and how the amplitudes are fixed.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct Kink {
     /// Kink point (m).
     pub at: f64,
@@ -49,7 +49,7 @@ pub struct Kink {
 }
 
 /// The kinks of a density; empty unless it is coupled to a stick traction.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct Kinks(pub Vec<Kink>);
 
 /// The stretch `[u, v]` of a kink term at `at` on `side` of a contact `[c − a, c + a]`.

@@ -12,12 +12,12 @@
 
 use std::sync::Arc;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::{ContactModel, ContactState};
 
 /// Where the strain of a memory piece comes from.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum StrainSource {
     /// Spence's self-similar normal-loading law `∂ux/∂x = C|x|` (seed eq. 20).
@@ -28,23 +28,27 @@ pub enum StrainSource {
     /// The strain of a stored end-of-phase state (eq. A evaluated exactly).
     State {
         /// The state.
+        #[serde(with = "crate::shared")]
         state: Arc<ContactState>,
     },
 }
 
 /// One piece `[lo, hi]` of the memory.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Piece {
-    /// Left end (m).
+    /// Left end (m; −∞ for the first piece).
+    #[serde(with = "crate::shared::extended")]
     pub lo: f64,
-    /// Right end (m).
+    /// Right end (m; +∞ for the last piece).
+    #[serde(with = "crate::shared::extended")]
     pub hi: f64,
     /// Source of the strain.
+    #[serde(with = "crate::shared")]
     pub source: Arc<StrainSource>,
 }
 
 /// The stored strain field, covering the whole real line.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Memory {
     /// Pieces in increasing x, contiguous.
     pub pieces: Vec<Piece>,

@@ -147,7 +147,7 @@ pub struct ContactModel {
 }
 
 /// How the charge is split, `g = χ p + w`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct ChargeSplit {
     /// χ (C/N).
     pub ratio: f64,

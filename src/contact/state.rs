@@ -4,7 +4,7 @@
 //! transforms, the slip shape S and the strains (eq. (A) of the module docs of
 //! [`crate::contact`]).
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::quadrature::{BoundedSeries, UnboundedSeries};
 
@@ -16,7 +16,7 @@ use super::{
 };
 
 /// The shear traction on the contact: `q = η p S(x) + q̃(x)` (see module docs of the solvers).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Traction {
     /// Friction coefficient η used in the slip zones.
     pub friction: f64,
@@ -29,7 +29,10 @@ pub struct Traction {
 }
 
 /// The solution at one instant.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+///
+/// Written as plain data; its shape table as whether it was built, rebuilt on reading.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(remote = "Self")]
 pub struct ContactState {
     /// Normal load P (N/m).
     pub normal_load: f64,
@@ -58,8 +61,39 @@ pub struct ContactState {
     pub traction: Traction,
     /// Quadrature table `(t, w p(t), S(t))` of [`ContactState::shape_cauchy`] for a stored
     /// state whose slip zones have opposite signs (built by [`ContactState::frozen`]).
-    #[serde(skip)]
+    #[serde(serialize_with = "built", deserialize_with = "to_build")]
     pub shape_table: Option<std::sync::Arc<Vec<(f64, f64, f64)>>>,
+}
+
+impl Serialize for ContactState {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        Self::serialize(self, serializer)
+    }
+}
+
+impl<'de> Deserialize<'de> for ContactState {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let mut state = Self::deserialize(deserializer)?;
+        if state.shape_table.is_some() {
+            state.tabulate_shape();
+        }
+        Ok(state)
+    }
+}
+
+/// Whether a table was built.
+fn built<S: serde::Serializer, T>(
+    table: &Option<std::sync::Arc<T>>,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    serializer.serialize_bool(table.is_some())
+}
+
+/// An empty table where one was built, to be rebuilt.
+fn to_build<'de, D: serde::Deserializer<'de>, T: Default>(
+    deserializer: D,
+) -> Result<Option<std::sync::Arc<T>>, D::Error> {
+    Ok(bool::deserialize(deserializer)?.then(Default::default))
 }
 
 impl ContactState {

@@ -3,7 +3,7 @@
 //! the piecewise Chebyshev tables (`ChainTable`) of q̃ and `H'q̃` that make a long chain cheap
 //! to evaluate.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::quadrature::BoundedSeries;
 
@@ -14,7 +14,12 @@ use super::{
 };
 
 /// The stick zone `[lo, hi]` and the bounded correction `q̃` on it.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+///
+/// Written as plain data: its tables as the number of points they were built with, rebuilt
+/// from the zone when it is read ([`StickZoneData`]), so a zone read back evaluates to the bit
+/// as the one written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(from = "StickZoneData")]
 pub struct StickZone {
     /// Left end (m).
     pub lo: f64,
@@ -27,7 +32,7 @@ pub struct StickZone {
     pub kink: f64,
     /// Correction inherited from the state that began the phase; it carries the exact
     /// square-root structure of the memory at old stick ends (see [`Inherited`]).
-    #[serde(skip)]
+    #[serde(with = "crate::shared::option")]
     pub inherited: Option<std::sync::Arc<Inherited>>,
     /// The square-root coefficients `[k_lo, k_hi]` of the whole q̃ at the ends,
     /// `q̃ ≈ k_lo √(x − lo)` and `q̃ ≈ k_hi √(hi − x)` (Pa/√m): they fix the kinks of p and w
@@ -41,17 +46,53 @@ pub struct StickZone {
     /// docs, "Kinks at the stick ends").
     pub extras: Vec<(f64, f64, f64)>,
     /// `H'q̃` tabulated once the zone begins a phase ([`StickZone::tabulate`]).
-    #[serde(skip)]
     pub(super) cauchy_table: TableCache,
     /// q̃ tabulated with it.
-    #[serde(skip)]
+    #[serde(skip_serializing)]
     pub(super) value_table: TableCache,
     /// `H'q̃` on the two outer pieces alone, `[lo − w, lo]` and `[hi, hi + w]` (w the zone's
     /// width), for a zone without [`Self::tabulate`]'s table whose transform is wanted at many
     /// points of the slip zones (`EXTERIOR_TABLE_POINTS`; the checks and increments of the
     /// steps it ends and begins).
-    #[serde(skip)]
     pub(super) exterior_table: TableCache<[ChainTable; 2]>,
+}
+
+/// A [`StickZone`] as written: its data, and which of its tables were built (the points per
+/// piece of [`StickZone::tabulate`]'s, whether the exterior ones were), rebuilt on reading.
+/// A table is a function of the zone and of its chain, whose zones are read (and tabulated)
+/// first and were tabulated before any zone inherited from them.
+#[derive(Deserialize)]
+struct StickZoneData {
+    lo: f64,
+    hi: f64,
+    correction: BoundedSeries,
+    kink: f64,
+    #[serde(with = "crate::shared::option")]
+    inherited: Option<std::sync::Arc<Inherited>>,
+    end_roots: [f64; 2],
+    end_signs: [f64; 2],
+    extras: Vec<(f64, f64, f64)>,
+    cauchy_table: Option<usize>,
+    exterior_table: bool,
+}
+
+impl From<StickZoneData> for StickZone {
+    fn from(d: StickZoneData) -> Self {
+        let zone = Self {
+            inherited: d.inherited,
+            end_roots: d.end_roots,
+            end_signs: d.end_signs,
+            extras: d.extras,
+            ..Self::new(d.lo, d.hi, d.correction, d.kink)
+        };
+        if let Some(nodes) = d.cauchy_table {
+            zone.tabulate(nodes);
+        }
+        if d.exterior_table {
+            zone.build_exterior_tables();
+        }
+        zone
+    }
 }
 
 /// `H'q̃` of a zone with its whole chain, interpolated piecewise: on each piece between the
@@ -108,6 +149,11 @@ impl ChainTable {
             })
             .collect();
         Self { ends, coefficients }
+    }
+
+    /// Chebyshev points per piece.
+    fn nodes(&self) -> usize {
+        self.coefficients.first().map_or(0, Vec::len)
     }
 
     /// The interpolated value at x, `None` outside the tabulated range.
@@ -219,6 +265,20 @@ impl<T> Default for TableCache<T> {
 impl<T> PartialEq for TableCache<T> {
     fn eq(&self, _: &Self) -> bool {
         true
+    }
+}
+
+/// Written as the points per piece it was built with (`null` when not built).
+impl Serialize for TableCache {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        self.0.get().map(ChainTable::nodes).serialize(serializer)
+    }
+}
+
+/// Written as whether it was built.
+impl Serialize for TableCache<[ChainTable; 2]> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        self.0.get().is_some().serialize(serializer)
     }
 }
 
@@ -539,7 +599,13 @@ impl StickZone {
         if xs.iter().filter(|&&x| outer(x)).count() < EXTERIOR_TABLE_POINTS {
             return None;
         }
-        Some(self.exterior_table.0.get_or_init(|| {
+        Some(self.build_exterior_tables())
+    }
+
+    /// Build the exterior tables (no-op if built).
+    fn build_exterior_tables(&self) -> &[ChainTable; 2] {
+        let width = self.hi - self.lo;
+        self.exterior_table.0.get_or_init(|| {
             let nodes = exterior_table_nodes(self.series_terms());
             let table = |from: f64, to: f64| {
                 ChainTable::interpolating_batch(vec![from, to], nodes, |xs, out| {
@@ -550,7 +616,7 @@ impl StickZone {
                 table(self.lo - width, self.lo),
                 table(self.hi, self.hi + width),
             ]
-        }))
+        })
     }
 
     /// [`Self::correction_cauchys_into`] from the series and the chain (no table).

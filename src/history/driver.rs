@@ -23,8 +23,9 @@ use super::load::LoadPoint;
 use super::record::{Observer, StateView, StepFailure, StepRecord};
 use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
 
-/// Driver state that outlives a step.
-#[derive(Debug, Clone)]
+/// Driver state that outlives a step: plain data, written and read back to the bit
+/// ([`crate::history::HistoryState`]).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct DriverState {
     /// Committed contact state.
     pub state: ContactState,
@@ -38,6 +39,7 @@ pub struct DriverState {
     /// predictor of the next step.
     history: Vec<[f64; 5]>,
     /// Stick zone (with its correction chain) of the state that began the phase.
+    #[serde(with = "crate::shared::option")]
     base: Option<Arc<crate::contact::StickZone>>,
     /// Tangential load at the start of the phase (N/m).
     phase_start_load: f64,

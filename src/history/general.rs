@@ -218,9 +218,11 @@ impl ZoneCount {
     }
 }
 
-/// A run of steps taken by the general solver.
-#[derive(Debug, Clone)]
+/// A run of steps taken by the general solver. Plain data but for its solver, which is rebuilt
+/// from the model and the state's mesh when the run is read back ([`GeneralRun::restore`]).
+#[derive(Debug, Clone, Serialize)]
 pub struct GeneralRun {
+    #[serde(skip)]
     solver: Arc<Solver>,
     /// The committed element state.
     pub state: GeneralState,
@@ -238,6 +240,19 @@ pub struct GeneralRun {
     pub first_began_at_handover: bool,
     /// The works of P and of the electric load summed over the steps taken (J/m), and those of
     /// the last step.
+    works: [[f64; 2]; 2],
+}
+
+/// A [`GeneralRun`] as written (without its solver).
+#[derive(Debug, Clone, Deserialize)]
+pub struct GeneralRunData {
+    state: GeneralState,
+    offset: f64,
+    phase_sign: Option<f64>,
+    phase: usize,
+    phases_begun: usize,
+    steps: usize,
+    first_began_at_handover: bool,
     works: [[f64; 2]; 2],
 }
 
@@ -294,6 +309,22 @@ impl GeneralRun {
             steps: 0,
             first_began_at_handover: false,
             works: [[0.0; 2]; 2],
+        }
+    }
+
+    /// The run written as `data`, its solver rebuilt for `model` on the state's mesh.
+    pub fn restore(model: &ContactModel, data: GeneralRunData) -> Self {
+        let solver = Solver::new(model, data.state.mesh.clone(), Options::default());
+        Self {
+            solver: Arc::new(solver),
+            state: data.state,
+            offset: data.offset,
+            phase_sign: data.phase_sign,
+            phase: data.phase,
+            phases_begun: data.phases_begun,
+            steps: data.steps,
+            first_began_at_handover: data.first_began_at_handover,
+            works: data.works,
         }
     }
 

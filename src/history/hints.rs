@@ -7,13 +7,15 @@
 
 use std::sync::{Arc, OnceLock};
 
+use serde::{Deserialize, Serialize};
+
 use crate::contact::tangential::Recalled;
 use crate::contact::{ContactModel, ContactState};
 
 use super::increments::StepIncrements;
 
 /// The accepted steps of one phase ([`Recalled`]).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub(super) struct PhaseTrace {
     /// `[Q, lo, hi, a, c]` of the state the phase began from.
     pub(super) start: [f64; 5],
@@ -24,7 +26,7 @@ pub(super) struct PhaseTrace {
 }
 
 /// An accepted step of a phase, kept for recall.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub(super) struct TraceStep {
     /// The step's load (N/m).
     pub(super) q: f64,
@@ -36,7 +38,7 @@ pub(super) struct TraceStep {
 
 /// A traced step's increments, for a later step that repeats it: they are a function of the
 /// two states and the anchor.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub(super) struct TracedIncrements {
     /// [`Footprint`] of the state the step began from.
     pub(super) from: Footprint,
@@ -44,7 +46,32 @@ pub(super) struct TracedIncrements {
     /// ([`finish_step`]).
     ///
     /// [`finish_step`]: super::finish_step
+    #[serde(with = "set_once")]
     pub(super) value: Arc<OnceLock<(f64, StepIncrements)>>,
+}
+
+/// A cell set once, written as its value (`null` while unset).
+mod set_once {
+    use std::sync::{Arc, OnceLock};
+
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub(super) fn serialize<S: Serializer, T: Serialize>(
+        cell: &Arc<OnceLock<T>>,
+        serializer: S,
+    ) -> Result<S::Ok, S::Error> {
+        cell.get().serialize(serializer)
+    }
+
+    pub(super) fn deserialize<'de, D: Deserializer<'de>, T: Deserialize<'de>>(
+        deserializer: D,
+    ) -> Result<Arc<OnceLock<T>>, D::Error> {
+        let cell = OnceLock::new();
+        if let Some(value) = Option::<T>::deserialize(deserializer)? {
+            let _ = cell.set(value);
+        }
+        Ok(Arc::new(cell))
+    }
 }
 
 impl TracedIncrements {
@@ -79,7 +106,7 @@ pub(super) fn footprint(state: &ContactState) -> Footprint {
 }
 
 /// The current phase's trace and the last finished one of each direction.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub(super) struct Traces {
     pub(super) current: Option<PhaseTrace>,
     /// Reverse (index 0) and forward (index 1).

@@ -25,7 +25,7 @@ pub struct IncrementInputs {
 }
 
 /// The increments of a step and the values at its state that the next step reuses.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct StepIncrements {
     /// Δδ (m).
     pub displacement: f64,

@@ -33,6 +33,27 @@ impl LoadHistory {
         points
     }
 
+    /// The load points of a run, numbered from 1: a ramp from Q = 0 to the first point in one
+    /// segment's worth of steps (when it is not zero), then [`Self::steps`].
+    pub fn load_points(&self) -> Vec<LoadPoint> {
+        let (t0, q0) = self.points.first().copied().unwrap_or((0.0, 0.0));
+        let mut steps = Vec::new();
+        if q0.abs() > 0.0 {
+            let n = self
+                .steps_per_segment
+                .max((q0.abs() / self.max_step).ceil() as usize);
+            for i in 1..=n {
+                steps.push((t0, q0 * i as f64 / n as f64));
+            }
+        }
+        steps.extend(self.steps().into_iter().map(|(_, t, q)| (t, q)));
+        steps
+            .into_iter()
+            .enumerate()
+            .map(|(i, (t, q))| LoadPoint { step: i + 1, t, q })
+            .collect()
+    }
+
     /// Check the history before any solving: finite values, strictly increasing times, and
     /// `|Q| < ηP` at every point (a point at or beyond ηP is gross sliding).
     pub fn validate(&self, path: &str, limit: f64) -> Vec<Issue> {

@@ -142,6 +142,10 @@ pub trait Observer {
     fn on_handover(&mut self, _failure: &StepFailure) {}
     /// Called when a new phase begins, with the memory that the phase will keep.
     fn on_phase(&mut self, _phase: usize, _memory: &Memory) {}
+    /// Called after the step at each turning point of the load and the last step
+    /// ([`super::turning_points`]), with the state after it: everything the steps that
+    /// follow need ([`super::HistoryState`]), to be written as a checkpoint.
+    fn on_checkpoint(&mut self, _last: &StepRecord, _state: super::HistoryStateView<'_>) {}
 }
 
 /// An observer that does nothing.

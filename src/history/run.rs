@@ -16,14 +16,15 @@ use super::increments::{IncrementInputs, StepIncrements};
 use super::load::{LoadHistory, LoadPoint};
 use super::record::{NoObserver, Observer, StateView, StepFailure, StepRecord};
 use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
+use super::state::{HistoryState, HistoryStateView};
 
-/// A finished run: the records and the final driver state.
+/// A finished run: the records and the final state.
 #[derive(Debug, Clone)]
 pub struct HistoryRun {
     /// One record per accepted step (step 0 = end of normal loading).
     pub records: Vec<StepRecord>,
-    /// The driver after the last step.
-    pub driver: DriverState,
+    /// The state after the last step.
+    pub state: HistoryState,
 }
 
 /// A failed run: what was accepted before the failure, and the failure.
@@ -31,8 +32,8 @@ pub struct HistoryRun {
 pub struct HistoryFailure {
     /// The steps accepted before the failure.
     pub records: Vec<StepRecord>,
-    /// The driver at the last accepted step.
-    pub driver: DriverState,
+    /// The state at the last accepted step.
+    pub state: HistoryState,
     /// The failed step.
     pub failure: StepFailure,
 }
@@ -46,70 +47,89 @@ pub fn run_history(
     options: RunOptions,
     observer: &mut dyn Observer,
 ) -> Result<HistoryRun, Box<HistoryFailure>> {
-    let mut driver = DriverState::after_normal_loading(normal);
+    let driver = DriverState::after_normal_loading(normal);
     let t0 = history.points.first().map_or(0.0, |p| p.0);
     let mut records = vec![record(0, t0, &driver, Regime::NormalLoading, None)];
     observer.on_step(&records[0], StateView::Spectral(&driver.state));
-    let q0 = history.points.first().map_or(0.0, |p| p.1);
-    let mut steps = Vec::new();
-    if q0.abs() > 0.0 {
-        // Ramp from Q = 0 to the first point in one segment's worth of steps.
-        let n = history
-            .steps_per_segment
-            .max((q0.abs() / history.max_step).ceil() as usize);
-        for i in 1..=n {
-            steps.push((t0, q0 * i as f64 / n as f64));
-        }
-    }
-    steps.extend(history.steps().into_iter().map(|(_, t, q)| (t, q)));
-    let points: Vec<LoadPoint> = steps
-        .into_iter()
-        .enumerate()
-        .map(|(i, (t, q))| LoadPoint { step: i + 1, t, q })
-        .collect();
+    let mut state = HistoryState::new(driver);
+    let points = history.load_points();
     let failure = continue_run(
         model,
         disc,
-        &mut driver,
+        &mut state,
         &points,
         options,
         observer,
         &mut records,
     );
     match failure {
-        None => Ok(HistoryRun { records, driver }),
+        None => Ok(HistoryRun { records, state }),
         Some(failure) => Err(Box::new(HistoryFailure {
             records,
-            driver,
+            state,
             failure,
         })),
     }
 }
 
-/// Walk the load points `points` from `driver` as [`run_history`] does, pushing a record per
-/// step onto `records` (the observer sees each), and return the first failure, if any.
+/// Which of `points` are turning points of the load, taken from the load `q` (a point
+/// followed by a step the other way, after any holds), and the last point: where a run
+/// passes its state to [`Observer::on_checkpoint`].
+pub fn turning_points(q: f64, points: &[LoadPoint]) -> Vec<bool> {
+    let mut turning = vec![false; points.len()];
+    let mut last_move: Option<(usize, f64)> = None;
+    let mut before = q;
+    for (k, p) in points.iter().enumerate() {
+        let dq = p.q - before;
+        before = p.q;
+        if dq.abs() > 0.0 {
+            if let Some((at, sign)) = last_move
+                && sign * dq < 0.0
+            {
+                turning[at] = true;
+            }
+            last_move = Some((k, dq.signum()));
+        }
+    }
+    if let Some(last) = turning.last_mut() {
+        *last = true;
+    }
+    turning
+}
+
+/// Walk the load points `points` from `state` as [`run_history`] does, pushing a record per
+/// step onto `records` (the observer sees each, and the state at each turning point,
+/// [`turning_points`]), and return the first failure, if any.
 ///
 /// The spectral solver takes the steps while it can (`spectral_stretch`). Unless the
 /// choice is [`SolverChoice::Spectral`], a step it fails is taken by the general solver,
 /// from the last committed state ([`GeneralRun::handover`]), and so are the steps after it
 /// until the spectral solver can take one again (`resumes`); [`SolverChoice::General`]
 /// hands over at the first step. The driver is left at the last state the spectral solver
-/// committed.
+/// committed, and the general solver's run in the state while it holds the steps.
 pub fn continue_run(
     model: &ContactModel,
     disc: &Discretisation,
-    driver: &mut DriverState,
+    state: &mut HistoryState,
     points: &[LoadPoint],
     options: RunOptions,
     observer: &mut dyn Observer,
     records: &mut Vec<StepRecord>,
 ) -> Option<StepFailure> {
+    let turning = turning_points(current_load(state), points);
     let mut next = 0;
-    let mut general = (options.solver == SolverChoice::General)
-        .then(|| GeneralRun::handover(model, driver, options.general_element_size));
+    if options.solver == SolverChoice::General && state.general.is_none() {
+        let driver = &state.driver;
+        state.general = Some(GeneralRun::handover(
+            model,
+            driver,
+            options.general_element_size,
+        ));
+    }
     while next < points.len() {
         let point = points[next];
-        let (run, step) = match general.take() {
+        let driver = &mut state.driver;
+        let (run, step) = match state.general.take() {
             Some(mut run) => {
                 let step = run.step(model, point);
                 (run, step)
@@ -119,7 +139,7 @@ pub fn continue_run(
                     model,
                     disc,
                     driver,
-                    &points[next..],
+                    (&points[next..], &turning[next..]),
                     options,
                     observer,
                     records,
@@ -166,12 +186,23 @@ pub fn continue_run(
         }
         observer.on_step(&record, StateView::General(run.solver(), &run.state));
         records.push(record);
-        next += 1;
         if back.is_none() {
-            general = Some(run);
+            state.general = Some(run);
         }
+        if turning[next] {
+            observer.on_checkpoint(records.last().expect("just pushed"), state.view());
+        }
+        next += 1;
     }
     None
+}
+
+/// The tangential load of the state's last step.
+fn current_load(state: &HistoryState) -> f64 {
+    match &state.general {
+        Some(run) => run.state.loads.tangential,
+        None => state.driver.state.tangential_load,
+    }
 }
 
 /// Whether the spectral solver takes the state of a general step back: only within the phase
@@ -237,7 +268,7 @@ fn spectral_stretch(
     model: &ContactModel,
     disc: &Discretisation,
     driver: &mut DriverState,
-    points: &[LoadPoint],
+    (points, turning): (&[LoadPoint], &[bool]),
     options: RunOptions,
     observer: &mut dyn Observer,
     records: &mut Vec<StepRecord>,
@@ -307,6 +338,14 @@ fn spectral_stretch(
                         taken: None,
                     });
                 }
+            }
+            if turning[k] {
+                finish(pending.take(), driver, records, observer);
+                let view = HistoryStateView {
+                    driver,
+                    general: None,
+                };
+                observer.on_checkpoint(records.last().expect("just pushed"), view);
             }
         }
         finish(pending.take(), driver, records, observer);

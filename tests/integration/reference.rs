@@ -255,6 +255,7 @@ fn ramped_state(
         steps_per_segment,
         0.1 * b.lim,
     )
+    .state
     .driver
     .state
 }
@@ -896,6 +897,7 @@ fn inherited_chains_stop_growing_in_steady_cycles() {
             repeats,
         );
         run_points(&b.model, &b.disc, &b.normal, points, 1, 0.1 * b.lim)
+            .state
             .driver
             .state
     };
@@ -1273,7 +1275,7 @@ fn figure3_history_completes_without_the_stick_end_kinks() {
         .collect();
     let run = run_points(&b.model, &b.disc, &b.normal, points, 10, 0.05 * lim);
     assert_eq!(run.records.len(), 61);
-    let s = &run.driver.state;
+    let s = &run.state.driver.state;
     assert!(s.pressure_kinks.0.is_empty() && s.charge_kinks.0.is_empty());
     let zone = s.traction.stick.as_ref().unwrap();
     assert!(zone.extras.is_empty() && zone.end_roots == [0.0; 2]);
@@ -1500,7 +1502,7 @@ fn pipelined_history_matches_sequential_steps() {
     assert!(sequential.iter().any(|r| r.dissipation > 0.0));
     assert_eq!(&run.records[1..], &sequential[..]);
     assert_eq!(
-        run.driver.displacement.to_bits(),
+        run.state.driver.displacement.to_bits(),
         driver.displacement.to_bits()
     );
     // Two steps sequentially, then the rest (the hold, the reversal) as a run continues.
@@ -1509,6 +1511,7 @@ fn pipelined_history_matches_sequential_steps() {
         step(&mut part, p);
     }
     let mut records = Vec::new();
+    let mut part = fretsim::history::HistoryState::new(part);
     let failure = continue_run(
         &b.model,
         &b.disc,
@@ -1520,7 +1523,10 @@ fn pipelined_history_matches_sequential_steps() {
     );
     assert!(failure.is_none());
     assert_eq!(&records[..], &sequential[2..]);
-    assert_eq!(part.displacement.to_bits(), driver.displacement.to_bits());
+    assert_eq!(
+        part.driver.displacement.to_bits(),
+        driver.displacement.to_bits()
+    );
 }
 
 /// A phase that begins from the same turning state as an earlier phase of its direction

@@ -252,7 +252,7 @@ impl Default for SlipOptions {
 }
 
 /// Worst violations of the step's admissibility checks (≤ 0 when admissible).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct StepAdmissibility {
     /// `max (|q| − ηp)/(η p0)` on the stick zone.
     pub stick_excess: f64,
@@ -260,7 +260,7 @@ pub struct StepAdmissibility {
     pub slip_reversal: f64,
     /// `min p/p0`.
     pub min_pressure: f64,
-    /// Where each measure is worst (m): stick excess, slip reversal, pressure.
+    /// Where each measure is worst (m): stick excess, slip reversal, pressure (not written).
     #[serde(skip)]
     pub worst_at: [f64; 3],
 }
@@ -290,7 +290,7 @@ pub struct SlipStep {
 }
 
 /// What a step passes to the next one of the same phase: its slip signs and Jacobian.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct WarmStart {
     /// Slip signs of the left and right slip zones.
     pub signs: (f64, f64),
@@ -316,7 +316,7 @@ pub struct WarmStart {
 /// and the mixed one, from the standard guess 1.0e−2 a inside the left contact end while its
 /// solution lies 1.6e−3 a inside, takes 20 evaluations; the two later reversals solved afresh
 /// (at −½ηP and +½ηP) took 11 evaluations each from that distance, against 31 and 21.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct PhaseStart {
     /// Slip signs of the left and right slip zones.
     pub signs: (f64, f64),
@@ -362,9 +362,10 @@ impl PhaseStart {
 /// The accepted state of the same step (the same load) in an earlier phase of the same
 /// direction that began from the same turning state, with its slip signs and final Jacobian.
 /// In a steady cycle the step's problem is that step's again, so its geometry solves it.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct Recalled {
     /// The earlier step's state.
+    #[serde(with = "crate::shared")]
     pub state: Arc<ContactState>,
     /// Its slip signs and Jacobian.
     pub warm: WarmStart,

@@ -1,0 +1,202 @@
+//! What a run carries from one load step to the next ([`HistoryState`]): the spectral driver's
+//! committed state and memory ([`DriverState`]) and, while the general solver holds the
+//! steps, its run ([`GeneralRun`]). Plain data: written by serde ([`HistoryState`] is
+//! `Serialize`; [`HistoryStateData`] is what is read back, [`HistoryState::restore`] rebuilds
+//! the general solver for the model) and read back to the bit, so that a run continued from a
+//! state read back takes the same steps, to the bit, as the run that wrote it.
+//!
+//! Values that several parts of the state share (a turning state in the memory, the recall
+//! traces and the phase's base) are written once ([`crate::shared`]); the tables that only make
+//! evaluations faster are written as what they were built with and rebuilt on reading.
+
+use serde::{Deserialize, Serialize};
+
+use crate::contact::ContactModel;
+
+use super::driver::DriverState;
+use super::general::{GeneralRun, GeneralRunData};
+
+/// Everything a step needs from the past.
+#[derive(Debug, Clone)]
+pub struct HistoryState {
+    /// The spectral solver's committed state, memory, phase and displacement datum (while the
+    /// general solver holds the steps: those of the step it took over at).
+    pub driver: DriverState,
+    /// The general solver's run while it holds the steps.
+    pub general: Option<GeneralRun>,
+}
+
+/// A [`HistoryState`] as read back, before its general solver is rebuilt.
+#[derive(Debug, Clone)]
+pub struct HistoryStateData {
+    driver: DriverState,
+    general: Option<GeneralRunData>,
+}
+
+/// A borrowed [`HistoryState`], as a run passes it to [`super::Observer::on_checkpoint`];
+/// written as the state is.
+#[derive(Debug, Clone, Copy)]
+pub struct HistoryStateView<'a> {
+    /// See [`HistoryState::driver`].
+    pub driver: &'a DriverState,
+    /// See [`HistoryState::general`].
+    pub general: Option<&'a GeneralRun>,
+}
+
+#[derive(Serialize)]
+struct Written<'a> {
+    driver: &'a DriverState,
+    general: Option<&'a GeneralRun>,
+}
+
+#[derive(Deserialize)]
+struct Read {
+    driver: DriverState,
+    general: Option<GeneralRunData>,
+}
+
+impl Serialize for HistoryStateView<'_> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let written = Written {
+            driver: self.driver,
+            general: self.general,
+        };
+        crate::shared::write_shared(|| written.serialize(serializer))
+    }
+}
+
+impl Serialize for HistoryState {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        self.view().serialize(serializer)
+    }
+}
+
+impl<'de> Deserialize<'de> for HistoryStateData {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let Read { driver, general } =
+            crate::shared::read_shared(|| Read::deserialize(deserializer))?;
+        Ok(Self { driver, general })
+    }
+}
+
+impl HistoryState {
+    /// The state at the start of a run from a driver.
+    pub fn new(driver: DriverState) -> Self {
+        Self {
+            driver,
+            general: None,
+        }
+    }
+
+    /// The borrowed view.
+    pub fn view(&self) -> HistoryStateView<'_> {
+        HistoryStateView {
+            driver: &self.driver,
+            general: self.general.as_ref(),
+        }
+    }
+
+    /// The state read back as `data`, for `model` (the model of the run that wrote it).
+    pub fn restore(model: &ContactModel, data: HistoryStateData) -> Self {
+        Self {
+            driver: data.driver,
+            general: data.general.map(|run| GeneralRun::restore(model, run)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::pressure::Discretisation;
+    use crate::history::{
+        LoadPoint, Observer, RunOptions, SolverChoice, StepRecord, continue_run,
+        driver_after_normal_loading,
+    };
+
+    /// Keeps each checkpoint as written (JSON), with the step it follows.
+    #[derive(Default)]
+    struct Checkpoints(Vec<(usize, String)>);
+
+    impl Observer for Checkpoints {
+        fn on_checkpoint(&mut self, last: &StepRecord, state: HistoryStateView<'_>) {
+            let json = serde_json::to_string(&state).expect("a state is written");
+            self.0.push((last.step, json));
+        }
+    }
+
+    fn written(records: &[StepRecord]) -> Vec<String> {
+        records
+            .iter()
+            .map(|r| serde_json::to_string(r).expect("a record is written"))
+            .collect()
+    }
+
+    /// A run of the default scenario's first `cycles`·4 + 1 load segments under `solver`,
+    /// then, from each checkpoint it wrote (read back), the rest of the run again: the state
+    /// read back writes the same text, and the steps after it are those of the uninterrupted
+    /// run to the bit (every field of every record, written with the shortest text that reads
+    /// back to the same `f64`).
+    fn continue_from_every_checkpoint(solver: SolverChoice, segments: usize) {
+        let sc = crate::scenario::default_scenario();
+        let disc = Discretisation::new(sc.collocation_points);
+        let history = sc.history.as_ref().expect("a history");
+        let points: Vec<LoadPoint> = history
+            .load_points()
+            .into_iter()
+            .take(segments * history.steps_per_segment)
+            .collect();
+        let options = RunOptions::new(solver);
+        let mut state = HistoryState::new(driver_after_normal_loading(&sc, &disc));
+        let mut checkpoints = Checkpoints::default();
+        let mut records = Vec::new();
+        let failure = continue_run(
+            &sc.model,
+            &disc,
+            &mut state,
+            &points,
+            options,
+            &mut checkpoints,
+            &mut records,
+        );
+        assert!(failure.is_none());
+        assert!(
+            checkpoints.0.len() >= 2,
+            "{} checkpoints",
+            checkpoints.0.len()
+        );
+        let all = written(&records);
+        for (step, json) in &checkpoints.0 {
+            let data: HistoryStateData = serde_json::from_str(json).expect("a state is read");
+            let mut restored = HistoryState::restore(&sc.model, data);
+            assert_eq!(
+                &serde_json::to_string(&restored).unwrap(),
+                json,
+                "the state after step {step} reads back to the text it was written as"
+            );
+            let rest: Vec<LoadPoint> = points.iter().filter(|p| p.step > *step).copied().collect();
+            let mut more = Vec::new();
+            let failure = continue_run(
+                &sc.model,
+                &disc,
+                &mut restored,
+                &rest,
+                options,
+                &mut crate::history::NoObserver,
+                &mut more,
+            );
+            assert!(failure.is_none());
+            assert_eq!(written(&more), all[*step..], "the steps after step {step}");
+        }
+    }
+
+    #[test]
+    fn a_run_continued_from_a_checkpoint_read_back_takes_the_same_steps_to_the_bit() {
+        continue_from_every_checkpoint(SolverChoice::Auto, 8);
+    }
+
+    #[test]
+    fn a_general_solver_run_continued_from_a_checkpoint_takes_the_same_steps_to_the_bit() {
+        continue_from_every_checkpoint(SolverChoice::General, 3);
+    }
+}
