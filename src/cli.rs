@@ -21,8 +21,13 @@ pub enum Command {
         /// Scenario file (JSON).
         scenario: Option<PathBuf>,
         /// Output folder (default: `output/<scenario name>`).
-        #[arg(long)]
+        #[arg(long, conflicts_with = "resume")]
         out: Option<PathBuf>,
+        /// Resume the interrupted run of the same scenario into this output folder from its
+        /// last checkpoint (written at every turning point of the load); with no checkpoint
+        /// there, run from the start. The output equals the uninterrupted run's.
+        #[arg(long, value_name = "DIR")]
+        resume: Option<PathBuf>,
         /// No progress output.
         #[arg(long)]
         quiet: bool,

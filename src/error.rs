@@ -184,6 +184,14 @@ pub enum Error {
         /// Why.
         reason: String,
     },
+    /// `--resume`: the folder's checkpoint cannot resume this run. Nothing was touched.
+    #[error("cannot resume the run in {path}: {reason}")]
+    Resume {
+        /// The output folder as given.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
     /// An output file could not be written.
     #[error("cannot write {path}: {source}")]
     WriteOutput {
@@ -204,6 +212,7 @@ impl Error {
             | Error::ParseScenario { .. }
             | Error::InvalidScenario { .. }
             | Error::OutputRefused { .. }
+            | Error::Resume { .. }
             | Error::WriteOutput { .. } => 2,
         }
     }

@@ -71,8 +71,9 @@ fn dispatch(command: Command) -> Result<(), Error> {
         Command::Run {
             scenario,
             out,
+            resume,
             quiet,
-        } => run(scenario, out, quiet),
+        } => run(scenario, out, resume, quiet),
         Command::Sweep {
             scenario,
             vary,
@@ -97,17 +98,51 @@ fn dispatch(command: Command) -> Result<(), Error> {
 }
 
 /// `fretsim run`: the output folder is claimed before the solve, so that a folder that may
-/// not be written is refused before any time is spent.
-fn run(path: Option<PathBuf>, out: Option<PathBuf>, quiet: bool) -> Result<(), Error> {
+/// not be written is refused before any time is spent. With `--resume DIR`, the checkpoint an
+/// interrupted run left in DIR is read (and checked against the scenario) first.
+fn run(
+    path: Option<PathBuf>,
+    out: Option<PathBuf>,
+    resume: Option<PathBuf>,
+    quiet: bool,
+) -> Result<(), Error> {
     let sc = match &path {
         Some(p) => scenario::load(p)?,
         None => scenario::default_scenario(),
     };
-    let out = out.unwrap_or_else(|| PathBuf::from("output").join(&sc.name));
-    let folder = folder::RunFolder::claim(&out, &folder::Protected::new(path.as_deref()))?;
+    let protected = folder::Protected::new(path.as_deref());
+    let (out, folder, resume) = match resume {
+        Some(dir) => {
+            let (folder, resume) = folder::RunFolder::claim_resuming(&dir, &protected, |s, r| {
+                io::checkpoint::read_checkpoint(&sc, s, r, &dir)
+            })?;
+            match &resume {
+                Some(r) => eprintln!(
+                    "fretsim: resuming {} after step {} from its checkpoint",
+                    dir.display(),
+                    r.step
+                ),
+                None => eprintln!(
+                    "fretsim: {} holds no checkpoint of an interrupted run; running from the start",
+                    dir.display()
+                ),
+            }
+            (dir, folder, resume)
+        }
+        None => {
+            let out = out.unwrap_or_else(|| PathBuf::from("output").join(&sc.name));
+            let folder = folder::RunFolder::claim(&out, &protected)?;
+            (out, folder, None)
+        }
+    };
     let total = sc.history.as_ref().map_or(0, |h| h.steps().len() as u64);
     let mut progress = Progress::new(total, quiet);
-    let result = io::run_with(&sc, folder, &mut progress);
+    let result = io::run_resumed(&sc, folder, resume, &mut progress).and_then(|mut result| {
+        match result.solution.failure.take() {
+            None => Ok(result),
+            Some(failure) => Err(failure),
+        }
+    });
     progress.finish();
     let result = match result {
         Ok(result) => result,

@@ -24,19 +24,27 @@ thread_local! {
     static READ: RefCell<Option<HashMap<u64, Box<dyn Any>>>> = const { RefCell::new(None) };
 }
 
-/// Run `write` (a serialisation) with shared `Arc`s written once.
+/// Run `write` (a serialisation) with shared `Arc`s written once; inside another
+/// `write_shared`, as part of the outer one (its values are shared with the outer's).
 pub fn write_shared<R>(write: impl FnOnce() -> R) -> R {
-    let outer = WRITTEN.with(|w| w.borrow_mut().replace(HashMap::new()));
+    if WRITTEN.with(|w| w.borrow().is_some()) {
+        return write();
+    }
+    WRITTEN.with(|w| *w.borrow_mut() = Some(HashMap::new()));
     let result = write();
-    WRITTEN.with(|w| *w.borrow_mut() = outer);
+    WRITTEN.with(|w| *w.borrow_mut() = None);
     result
 }
 
-/// Run `read` (a deserialisation) of what [`write_shared`] wrote.
+/// Run `read` (a deserialisation) of what [`write_shared`] wrote; inside another
+/// `read_shared`, as part of the outer one.
 pub fn read_shared<R>(read: impl FnOnce() -> R) -> R {
-    let outer = READ.with(|r| r.borrow_mut().replace(HashMap::new()));
+    if READ.with(|r| r.borrow().is_some()) {
+        return read();
+    }
+    READ.with(|r| *r.borrow_mut() = Some(HashMap::new()));
     let result = read();
-    READ.with(|r| *r.borrow_mut() = outer);
+    READ.with(|r| *r.borrow_mut() = None);
     result
 }
 

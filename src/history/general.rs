@@ -140,7 +140,7 @@ impl SolverKind {
 }
 
 /// The zone structure of a state.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct ZoneCount {
     /// Stick zones.
     pub stick: usize,

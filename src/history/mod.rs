@@ -83,7 +83,9 @@ pub use driver::{DriverState, Solved, SolvedStep, advance, finish_step, solve_st
 pub use general::{GeneralRun, GeneralRunData, RunOptions, SolverChoice, SolverKind, ZoneCount};
 pub use increments::{IncrementInputs, StepIncrements, step_dissipation};
 pub use load::{LoadHistory, LoadPoint};
-pub use record::{NoObserver, Observer, SolvedState, StateView, StepFailure, StepRecord};
+pub use record::{
+    NoObserver, Observer, SolvedState, SolvedStateData, StateView, StepFailure, StepRecord,
+};
 pub use regime::{PhaseEvent, Regime, next_regime, phase_event};
 pub use run::{HistoryFailure, HistoryRun, continue_run, run_history, turning_points};
 pub use state::{HistoryState, HistoryStateData, HistoryStateView};

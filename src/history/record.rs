@@ -17,7 +17,7 @@ use super::general::{SolverKind, ZoneCount};
 use super::regime::Regime;
 
 /// One recorded step.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
 pub struct StepRecord {
     /// Step number (0 = end of normal loading).
     pub step: usize,
@@ -75,7 +75,8 @@ pub enum StateView<'a> {
     General(&'a Arc<Solver>, &'a GeneralState),
 }
 
-/// An owned [`StateView`], kept for field output.
+/// An owned [`StateView`], kept for field output. Written as the state alone (the general
+/// solver is rebuilt when it is read back, [`SolvedState::restore`]).
 #[derive(Debug, Clone)]
 pub enum SolvedState {
     /// See [`StateView::Spectral`].
@@ -104,7 +105,42 @@ impl<'a> StateView<'a> {
     }
 }
 
+/// A [`SolvedState`] as written and read back.
+#[derive(Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolvedStateData<S = ContactState, G = GeneralState> {
+    /// A spectral state.
+    Spectral(S),
+    /// An element state.
+    General(G),
+}
+
+impl Serialize for SolvedState {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let data: SolvedStateData<&ContactState, &GeneralState> = match self {
+            SolvedState::Spectral(s) => SolvedStateData::Spectral(s),
+            SolvedState::General(_, s) => SolvedStateData::General(s),
+        };
+        data.serialize(serializer)
+    }
+}
+
 impl SolvedState {
+    /// The state written as `data`, for `model` (an element state gets a solver on its mesh).
+    pub fn restore(model: &ContactModel, data: SolvedStateData) -> Self {
+        match data {
+            SolvedStateData::Spectral(s) => SolvedState::Spectral(Box::new(s)),
+            SolvedStateData::General(s) => {
+                let solver = Solver::new(
+                    model,
+                    s.mesh.clone(),
+                    crate::contact::general::Options::default(),
+                );
+                SolvedState::General(Arc::new(solver), Box::new(s))
+            }
+        }
+    }
+
     /// The borrowed view.
     pub fn view(&self) -> StateView<'_> {
         match self {

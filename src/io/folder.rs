@@ -41,6 +41,9 @@ pub const MANIFEST: &str = "fretsim-manifest.json";
 /// The marker inside a staging folder (removed just before the folder is swapped in).
 const STAGING_MARKER: &str = ".fretsim-staging";
 
+/// The checkpoint's folder inside a staging folder ([`super::checkpoint`]).
+const CHECKPOINT: &str = "checkpoint";
+
 /// What a fretsim folder holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -363,8 +366,17 @@ impl RunFolder {
     /// staging folder. Nothing is solved yet and nothing of the user's is touched.
     pub fn claim(target: &Path, protected: &Protected) -> Result<Self, Error> {
         let (parent, name) = allowed(target, protected, FolderKind::Run)?;
-        let canonical = parent.join(&name);
         let lock = Lock::take(parent.join(format!(".{name}.fretsim-lock")), target)?;
+        Self::claim_locked(target, (parent, name), lock)
+    }
+
+    /// [`Self::claim`] of `target` (canonical parent and name) under the lock `lock`.
+    fn claim_locked(
+        target: &Path,
+        (parent, name): (PathBuf, String),
+        lock: Lock,
+    ) -> Result<Self, Error> {
+        let canonical = parent.join(&name);
         let staging = parent.join(format!(".{name}.fretsim-new"));
         let old = parent.join(format!(".{name}.fretsim-old"));
         clear_leftover(&staging, FolderKind::Run, target)?;
@@ -406,6 +418,62 @@ impl RunFolder {
         Ok(())
     }
 
+    /// Save a checkpoint in the staging folder (`checkpoint/`, [`super::checkpoint`]):
+    /// append `records` to `records.jsonl`, then replace `state.json` by `state` (written
+    /// aside and renamed, so that it is always whole).
+    pub fn save_checkpoint(&mut self, state: &[u8], records: &[u8]) -> Result<(), Error> {
+        let dir = self.staging.join(CHECKPOINT);
+        fs::create_dir_all(&dir).map_err(write_err(&dir))?;
+        let path = dir.join("records.jsonl");
+        let mut f = fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&path)
+            .map_err(write_err(&path))?;
+        f.write_all(records).map_err(write_err(&path))?;
+        let aside = dir.join("state.json.new");
+        fs::write(&aside, state).map_err(write_err(&aside))?;
+        let path = dir.join("state.json");
+        fs::rename(&aside, &path).map_err(write_err(&path))
+    }
+
+    /// Claim `target` as [`Self::claim`] does, taking over the checkpoint that an
+    /// interrupted run on it left in its staging folder: its `state.json` and `records.jsonl`,
+    /// read by `read` (`None` when there is none), and kept in the new staging folder until
+    /// the next checkpoint replaces them. When `read` refuses them, nothing is touched.
+    pub fn claim_resuming<T>(
+        target: &Path,
+        protected: &Protected,
+        read: impl FnOnce(&[u8], &[u8]) -> Result<T, Error>,
+    ) -> Result<(Self, Option<T>), Error> {
+        let (parent, name) = allowed(target, protected, FolderKind::Run)?;
+        let staging = parent.join(format!(".{name}.fretsim-new"));
+        // Read under the lock that the claim takes; the claim then clears the old staging
+        // folder.
+        let lock = Lock::take(parent.join(format!(".{name}.fretsim-lock")), target)?;
+        let dir = staging.join(CHECKPOINT);
+        let found = if staging.join(STAGING_MARKER).is_file() {
+            match (
+                fs::read(dir.join("state.json")),
+                fs::read(dir.join("records.jsonl")),
+            ) {
+                (Ok(state), Ok(records)) => Some((state, records)),
+                _ => None,
+            }
+        } else {
+            None
+        };
+        let resume = match &found {
+            Some((state, records)) => Some(read(state, records)?),
+            None => None,
+        };
+        let mut folder = Self::claim_locked(target, (parent, name), lock)?;
+        if let Some((state, records)) = &found {
+            folder.save_checkpoint(state, records)?;
+        }
+        Ok((folder, resume))
+    }
+
     /// The files written so far.
     pub fn files(&self) -> &[String] {
         &self.files
@@ -414,6 +482,10 @@ impl RunFolder {
     /// Write the manifest and swap the staging folder in for the target.
     pub fn commit(mut self) -> Result<PathBuf, Error> {
         pause_point("write");
+        let checkpoint = self.staging.join(CHECKPOINT);
+        if checkpoint.exists() {
+            fs::remove_dir_all(&checkpoint).map_err(write_err(&checkpoint))?;
+        }
         let mut files = self.files.clone();
         files.sort();
         let manifest = Manifest {

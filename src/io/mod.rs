@@ -9,9 +9,11 @@
 //! - [`csv`], [`plots`], [`history_plots`], [`svg`]: the files of a run; [`png`]: the PNG
 //!   beside each SVG plot (resvg, embedded font);
 //! - [`mod@sweep`]: `fretsim sweep`, and its result plots and maps (`sweep_plots`);
+//! - [`checkpoint`]: the checkpoints a run writes as it goes, and resuming from one;
 //! - [`folder`]: the output folder's rules: never touch what fretsim did not write, replace a
 //!   previous output atomically.
 
+pub mod checkpoint;
 pub mod csv;
 pub mod folder;
 pub mod history_plots;
@@ -23,5 +25,5 @@ pub mod svg;
 pub mod sweep;
 mod sweep_plots;
 
-pub use run::{RunResult, Solution, run, run_with, solve};
+pub use run::{RunResult, Solution, run, run_resumed, run_with, solve};
 pub use sweep::{Shard, SweepOptions, SweepOutput, Vary, sweep};

@@ -9,7 +9,9 @@ use crate::contact::normal::{NormalLoading, NormalOptions, solve_normal};
 use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
 use crate::error::Error;
+use crate::history::HistoryStateView;
 use crate::history::{RunOptions, SolvedState, SolverKind, StateView, StepRecord};
+use crate::io::checkpoint::{CheckpointSink, Kept, Resume, write_records, write_state};
 use crate::io::csv::{cycles_table, fields_table, steps_table};
 use crate::io::folder::{Protected, RunFolder};
 use crate::io::history_plots::history_plots;
@@ -50,6 +52,9 @@ pub struct Solution {
     pub cycles: Vec<CycleRow>,
     /// The solver failure that stopped the history part-way, if any.
     pub failure: Option<Error>,
+    /// The state at the last accepted step of a history that stopped part-way (written into
+    /// `failure.json`).
+    pub failure_state: Option<crate::history::HistoryState>,
 }
 
 /// Sample points for field output: the contact and a margin of one half-width each side,
@@ -83,49 +88,80 @@ pub struct FieldSet {
 /// Keeps, while the history runs, the states that the field files need: the turning points
 /// (the last step of each phase) that `output.turning_point_fields` asks for, the last step,
 /// and the steps at the snapshot times. A long run keeps a few states, not one per phase.
+/// With a checkpoint sink, it also writes a checkpoint at every turning point of the load
+/// ([`crate::io::checkpoint`]).
 pub(crate) struct Snapshots<'a> {
     inner: &'a mut dyn crate::history::Observer,
-    previous: Option<(crate::history::StepRecord, SolvedState)>,
-    kept: Vec<(crate::history::StepRecord, SolvedState)>,
-    times: &'a [f64],
-    tolerance: f64,
-    at_times: Vec<Option<(crate::history::StepRecord, SolvedState)>>,
-    handovers: Vec<Handover>,
+    scenario: &'a Scenario,
+    kept: Kept,
     /// Which turning points are kept (`output.turning_point_fields`).
     turning: TurningFields,
-    /// The last two turning points after phase 3 ([`TurningFields::FirstAndLast`]).
-    last: Vec<(crate::history::StepRecord, SolvedState)>,
+    /// Where checkpoints go, with the records not yet saved, the number saved, and the first
+    /// error in saving one.
+    checkpoints: Option<&'a mut dyn CheckpointSink>,
+    unsaved: Vec<StepRecord>,
+    saved: usize,
+    error: Option<Error>,
+    /// Checkpoints written by this process.
+    written: usize,
 }
 
 impl crate::history::Observer for Snapshots<'_> {
     fn on_step(&mut self, record: &crate::history::StepRecord, state: StateView<'_>) {
-        if let Some((prev, prev_state)) = self.previous.take()
+        let kept = &mut self.kept;
+        if let Some((prev, prev_state)) = kept.previous.take()
             && prev.phase != record.phase
             && prev.phase > 0
         {
             match self.turning {
-                TurningFields::All => self.kept.push((prev, prev_state)),
+                TurningFields::All => kept.turning.push((prev, prev_state)),
                 TurningFields::FirstAndLast if prev.phase <= 3 => {
-                    self.kept.push((prev, prev_state));
+                    kept.turning.push((prev, prev_state));
                 }
                 TurningFields::FirstAndLast => {
-                    if self.last.len() == 2 {
-                        self.last.remove(0);
+                    if kept.last.len() == 2 {
+                        kept.last.remove(0);
                     }
-                    self.last.push((prev, prev_state));
+                    kept.last.push((prev, prev_state));
                 }
                 TurningFields::None => {}
             }
         }
-        self.previous = Some((record.clone(), state.to_owned()));
+        kept.previous = Some((record.clone(), state.to_owned()));
         // The last step at a snapshot time wins (a ramp to a non-zero first point is solved
         // in several steps at the same time).
-        for (t, slot) in self.times.iter().zip(self.at_times.iter_mut()) {
-            if (record.t - t).abs() <= self.tolerance {
+        let times = &self.scenario.snapshots;
+        for (t, slot) in times.iter().zip(kept.at_times.iter_mut()) {
+            if (record.t - t).abs() <= self.scenario.time_tolerance {
                 *slot = Some((record.clone(), state.to_owned()));
             }
         }
+        if self.checkpoints.is_some() {
+            self.unsaved.push(record.clone());
+        }
         self.inner.on_step(record, state);
+    }
+
+    fn on_checkpoint(&mut self, last: &StepRecord, state: HistoryStateView<'_>) {
+        let Some(sink) = self.checkpoints.as_mut() else {
+            return;
+        };
+        if self.error.is_some() {
+            return;
+        }
+        let records = write_records(&self.unsaved);
+        let saved = self.saved + self.unsaved.len();
+        let bytes = write_state(self.scenario, last.step, saved, &self.kept, state);
+        match sink.save(&bytes, &records) {
+            Ok(()) => {
+                self.saved = saved;
+                self.unsaved.clear();
+            }
+            Err(e) => self.error = Some(e),
+        }
+        self.written += 1;
+        crate::io::folder::pause_point(&format!("checkpoint {}", self.written));
+        self.inner.on_checkpoint(last, state);
     }
 
     fn on_phase(&mut self, phase: usize, memory: &crate::contact::memory::Memory) {
@@ -133,7 +169,7 @@ impl crate::history::Observer for Snapshots<'_> {
     }
 
     fn on_handover(&mut self, failure: &crate::history::StepFailure) {
-        self.handovers.push(Handover {
+        self.kept.handovers.push(Handover {
             step: failure.step,
             t: failure.t,
             q: failure.q,
@@ -162,17 +198,31 @@ pub fn run_with(
 /// a write error.
 pub fn run_partial(
     scenario: &Scenario,
+    folder: RunFolder,
+    observer: &mut dyn crate::history::Observer,
+) -> Result<RunResult, Error> {
+    run_resumed(scenario, folder, None, observer)
+}
+
+/// As [`run_partial`], resuming from `resume` when given (a checkpoint that an interrupted
+/// run left in the folder, [`RunFolder::claim_resuming`] and
+/// [`crate::io::checkpoint::read_checkpoint`]). The run writes its checkpoints into the
+/// folder's staging folder as it goes ([`crate::io::checkpoint`]).
+pub fn run_resumed(
+    scenario: &Scenario,
     mut folder: RunFolder,
+    resume: Option<Resume>,
     observer: &mut dyn crate::history::Observer,
 ) -> Result<RunResult, Error> {
     crate::io::folder::pause_point("solve");
-    match solve(scenario, observer) {
+    match solve_from(scenario, observer, resume, Some(&mut folder)) {
         Ok(solution) => {
             let out_dir = write_solution(folder, scenario, &solution)?;
             Ok(RunResult { out_dir, solution })
         }
+        Err(error @ Error::WriteOutput { .. }) => Err(error),
         Err(error) => {
-            folder.write("failure.json", &failure_json(&error, None))?;
+            folder.write("failure.json", &failure_json(&error, None, None))?;
             folder.commit()?;
             Err(error)
         }
@@ -187,6 +237,17 @@ pub fn solve(
     scenario: &Scenario,
     observer: &mut dyn crate::history::Observer,
 ) -> Result<Solution, Error> {
+    solve_from(scenario, observer, None, None)
+}
+
+/// [`solve`], resuming from `resume` when given, and writing checkpoints into `checkpoints`
+/// when given ([`crate::io::checkpoint`]).
+pub(crate) fn solve_from<'a>(
+    scenario: &'a Scenario,
+    observer: &'a mut dyn crate::history::Observer,
+    resume: Option<Resume>,
+    checkpoints: Option<&'a mut dyn CheckpointSink>,
+) -> Result<Solution, Error> {
     let model = &scenario.model;
     let disc = Discretisation::new(scenario.collocation_points);
     let normal = solve_normal(model, &disc, scenario.normal_load, NormalOptions::default())
@@ -198,33 +259,61 @@ pub fn solve(
     // The tangential history, if any; a failure keeps the steps already solved.
     let mut records = Vec::new();
     let mut failure = None;
+    let mut failure_state = None;
+    let (kept, resumed) = match resume {
+        Some(Resume {
+            step,
+            records,
+            snapshots,
+            state,
+        }) => (snapshots, Some((step, records, state))),
+        None => (
+            Kept {
+                previous: None,
+                turning: Vec::new(),
+                last: Vec::new(),
+                at_times: vec![None; scenario.snapshots.len()],
+                handovers: Vec::new(),
+            },
+            None,
+        ),
+    };
+    let saved = resumed.as_ref().map_or(0, |(_, records, _)| records.len());
     let mut snapshots = Snapshots {
         inner: observer,
-        previous: None,
-        kept: Vec::new(),
-        times: &scenario.snapshots,
-        tolerance: scenario.time_tolerance,
-        at_times: vec![None; scenario.snapshots.len()],
-        handovers: Vec::new(),
+        scenario,
+        kept,
         turning: scenario.raw.output.turning_point_fields,
-        last: Vec::new(),
+        checkpoints,
+        unsaved: Vec::new(),
+        saved,
+        error: None,
+        written: 0,
     };
     if let Some(history) = &scenario.history {
-        match crate::history::run_history(
-            model,
-            &disc,
-            &normal,
-            history,
-            RunOptions {
-                general_element_size: scenario.raw.numerics.general_element_size,
-                ..RunOptions::new(scenario.solver)
-            },
-            &mut snapshots,
-        ) {
+        let options = RunOptions {
+            general_element_size: scenario.raw.numerics.general_element_size,
+            ..RunOptions::new(scenario.solver)
+        };
+        let run = match resumed {
+            None => {
+                crate::history::run_history(model, &disc, &normal, history, options, &mut snapshots)
+            }
+            Some((step, done, state)) => resume_history(
+                model,
+                &disc,
+                history,
+                (step, done, state),
+                options,
+                &mut snapshots,
+            ),
+        };
+        match run {
             Ok(run) => records = run.records,
             Err(f) => {
                 let f = *f;
                 records = f.records;
+                failure_state = Some(f.state);
                 failure = Some(Error::Solve {
                     context: f.failure.to_string(),
                     failure: f.failure.failure,
@@ -232,6 +321,10 @@ pub fn solve(
             }
         }
     }
+    if let Some(e) = snapshots.error.take() {
+        return Err(e);
+    }
+    let kept = snapshots.kept;
     warnings.extend(stalled_warning(&records));
     let tolerance = scenario.raw.numerics.cycle_tolerance;
     let (cycles, verdict) = analyse_cycles(&records, tolerance);
@@ -253,13 +346,8 @@ pub fn solve(
         points: sample(&SolvedState::Spectral(Box::new(normal.state.clone()))),
         ends: ZoneEnds::of(&normal.state),
     }];
-    let (at_snapshots, snapshot_rows) = snapshot_fields(
-        scenario,
-        &snapshots.at_times,
-        &sample,
-        &records,
-        &mut warnings,
-    );
+    let (at_snapshots, snapshot_rows) =
+        snapshot_fields(scenario, &kept.at_times, &sample, &records, &mut warnings);
     fields.extend(at_snapshots);
     let summary = Summary {
         fretsim_version: env!("CARGO_PKG_VERSION"),
@@ -272,14 +360,14 @@ pub fn solve(
         normal_loading: normal_summary(model, &normal),
         history: history_summary,
         snapshots: snapshot_rows,
-        solver: solver_statistics(scenario, &normal, &records, snapshots.handovers),
+        solver: solver_statistics(scenario, &normal, &records, kept.handovers),
         warnings,
     };
     // Turning points and the last step, unless switched off.
     let mut turning_fields = Vec::new();
     if scenario.raw.output.turning_point_fields != TurningFields::None {
-        let kept = snapshots.kept.iter().chain(&snapshots.last);
-        for (rec, state) in kept.chain(snapshots.previous.iter()) {
+        let turning = kept.turning.iter().chain(&kept.last);
+        for (rec, state) in turning.chain(kept.previous.iter()) {
             turning_fields.push(FieldSet {
                 stem: format!("step_{:05}", rec.step),
                 label: format!("step {}", rec.step),
@@ -295,7 +383,42 @@ pub fn solve(
         records,
         cycles,
         failure,
+        failure_state,
     })
+}
+
+/// The rest of `history` after step `step`, from `state` with the records `records` of the
+/// steps taken ([`crate::history::run_history`] from a checkpoint).
+fn resume_history(
+    model: &crate::contact::ContactModel,
+    disc: &Discretisation,
+    history: &crate::history::LoadHistory,
+    (step, mut records, mut state): (usize, Vec<StepRecord>, crate::history::HistoryState),
+    options: RunOptions,
+    observer: &mut dyn crate::history::Observer,
+) -> Result<crate::history::HistoryRun, Box<crate::history::HistoryFailure>> {
+    let points: Vec<_> = history
+        .load_points()
+        .into_iter()
+        .filter(|p| p.step > step)
+        .collect();
+    let failure = crate::history::continue_run(
+        model,
+        disc,
+        &mut state,
+        &points,
+        options,
+        observer,
+        &mut records,
+    );
+    match failure {
+        None => Ok(crate::history::HistoryRun { records, state }),
+        Some(failure) => Err(Box::new(crate::history::HistoryFailure {
+            records,
+            state,
+            failure,
+        })),
+    }
 }
 
 /// The contact and stick-zone ends of a state, for the marks of its field plots: the
@@ -407,6 +530,7 @@ pub(crate) fn write_solution(
         records,
         cycles,
         failure,
+        failure_state,
     } = solution;
     let limit = scenario.model.friction * scenario.normal_load;
     let scales = plot_scales(scenario, summary);
@@ -464,7 +588,8 @@ pub(crate) fn write_solution(
         )?;
     }
     if let Some(e) = failure {
-        folder.write("failure.json", &failure_json(e, records.last()))?;
+        let json = failure_json(e, records.last(), failure_state.as_ref());
+        folder.write("failure.json", &json)?;
     }
     let mut written = folder.files().to_vec();
     written.sort();
@@ -489,11 +614,24 @@ fn plot_scales(scenario: &Scenario, summary: &Summary) -> PlotScales {
     }
 }
 
-/// `failure.json`: the error and the last accepted step (none when normal loading failed).
-pub(crate) fn failure_json(error: &Error, last: Option<&crate::history::StepRecord>) -> Vec<u8> {
-    let body = serde_json::json!({
-        "error": error.to_string(),
-        "last_accepted_step": last,
-    });
+/// `failure.json`: the error, the last accepted step and the state after it (none when normal
+/// loading failed; the state as a checkpoint holds it, [`crate::history::HistoryState`]).
+pub(crate) fn failure_json(
+    error: &Error,
+    last: Option<&crate::history::StepRecord>,
+    state: Option<&crate::history::HistoryState>,
+) -> Vec<u8> {
+    #[derive(serde::Serialize)]
+    struct Failure<'a> {
+        error: String,
+        last_accepted_step: Option<&'a StepRecord>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        state: Option<&'a crate::history::HistoryState>,
+    }
+    let body = Failure {
+        error: error.to_string(),
+        last_accepted_step: last,
+        state,
+    };
     serde_json::to_vec_pretty(&body).expect("serialises")
 }

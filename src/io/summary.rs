@@ -181,7 +181,7 @@ pub struct SolverStatistics {
 }
 
 /// A step that the spectral solver could not take, taken by the general solver.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct Handover {
     /// Step number.
     pub step: usize,

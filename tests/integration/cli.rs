@@ -1164,9 +1164,15 @@ fn solver_failure_exits_1_and_keeps_the_steps_solved() {
     struct Failure {
         error: String,
         last_accepted_step: serde_json::Value,
+        state: fretsim::history::HistoryStateData,
     }
     let f: Failure =
         serde_json::from_str(&std::fs::read_to_string(out.join("failure.json")).unwrap()).unwrap();
+    // The state after the last accepted step, as a checkpoint holds it.
+    let model = fretsim::load(&file).unwrap().model;
+    let state = fretsim::history::HistoryState::restore(&model, f.state);
+    let q = f.last_accepted_step["q"].as_f64().unwrap();
+    assert_eq!(state.driver.state.tangential_load.to_bits(), q.to_bits());
     let s = read_summary(&out);
     let h = s.history.as_ref().unwrap();
     assert_eq!(h.failure.as_deref(), Some(f.error.as_str()));

@@ -5,3 +5,4 @@ mod fuzz;
 mod hybrid;
 mod output_safety;
 mod reference;
+mod resume;

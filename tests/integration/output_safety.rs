@@ -9,7 +9,7 @@ use std::process::{Child, Command, Stdio};
 use crate::cli::{fretsim, scenario_path};
 
 /// Every file under `dir` with its contents, sorted: a folder's complete state.
-fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+pub(crate) fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
     fn walk(root: &Path, dir: &Path, out: &mut Vec<(String, Vec<u8>)>) {
         for e in std::fs::read_dir(dir).unwrap() {
             let p = e.unwrap().path();
@@ -173,7 +173,7 @@ fn a_previous_output_is_replaced_as_a_whole_and_a_users_file_protects_it() {
 }
 
 /// Start a run that pauses at `stage` (the `FRETSIM_PAUSE_AT` hook) and wait until it is there.
-fn paused_run(scenario: Option<&Path>, out: &Path, stage: &str) -> Child {
+pub(crate) fn paused_run(scenario: Option<&Path>, out: &Path, stage: &str) -> Child {
     let mut cmd = fretsim();
     cmd.arg("run");
     if let Some(s) = scenario {
