@@ -26,10 +26,10 @@ pub(super) struct Reused {
 }
 
 /// `(H'q̃ of the chain, remembered strain)` at the stick points.
-type StickParts = (Vec<f64>, Vec<f64>);
+pub(super) type StickParts = (Vec<f64>, Vec<f64>);
 
 /// `(S, inherited traction)` at the pressure points and at the charge points.
-type SampleParts = (Vec<(f64, f64)>, Vec<(f64, f64)>);
+pub(super) type SampleParts = (Vec<(f64, f64)>, Vec<(f64, f64)>);
 
 /// What an entry of [`Reused`] depends on: the grid's size, the interval the points are
 /// mapped onto, the fixed part of q̃ (its inherited link, compared by identity, and its

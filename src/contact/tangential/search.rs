@@ -20,7 +20,7 @@ use super::residual::{
     inner_tolerance,
 };
 use super::reuse::{COARSE_MAPS, LentMaps, Reused};
-use super::{PhaseStart, Recalled, SlipOptions, SlipStep, WarmStart};
+use super::{PhaseStart, Recalled, SlipOptions, SlipStep, StepAdmissibility, WarmStart};
 
 /// Largest first residual with which a recalled step is continued ([`Recalled`]): where the
 /// step's problem is the recalled one's, the first residual is the recalled state's own, below
@@ -64,65 +64,9 @@ pub fn solve_slip(
     // memory), the part of the zone that is already at the friction limit slips at once and
     // the ends move to an older stick/slip boundary of the memory. So the remembered
     // boundaries inside the current zone are tried as starting points when the warm start fails.
-    let (c, a) = (start.centre, start.half_width);
-    let inset = 1e-3 * a;
-    let breaks: Vec<f64> = memory
-        .breakpoints()
-        .into_iter()
-        .filter(|&x| x > guess.0.min(c - a) - a && x < guess.1.max(c + a) + a)
-        .collect();
-    let mut remembered = Vec::new();
-    for i in 0..breaks.len() / 2 {
-        let (l, r) = (breaks[i], breaks[breaks.len() - 1 - i]);
-        if r - l > 2.0 * inset && l > c - a && r < c + a {
-            remembered.push((l + inset, r - inset));
-        }
-    }
-    // Other pairs of remembered boundaries (an earlier turning point's zone need not be
-    // nested symmetrically in the breakpoint list), widest first.
-    let mut pairs: Vec<(f64, f64)> = Vec::new();
-    for (i, &l) in breaks.iter().enumerate() {
-        for &r in &breaks[i + 1..] {
-            if r - l > 2.0 * inset && l > c - a && r < c + a {
-                pairs.push((l + inset, r - inset));
-            }
-        }
-    }
-    pairs.sort_by(|x, y| (y.1 - y.0).total_cmp(&(x.1 - x.0)));
-    remembered.extend(pairs);
-    let mut warm_guesses: Vec<(f64, f64)> = Vec::new();
-    let mut jump_guesses: Vec<(f64, f64)> = Vec::new();
-    for (k, g) in guesses_in.iter().chain(&remembered).enumerate() {
-        let same = |h: &(f64, f64)| (h.0 - g.0).abs().max((h.1 - g.1).abs()) <= 1e-12 * a;
-        if !warm_guesses.iter().chain(&jump_guesses).any(same) {
-            if k < guesses_in.len() {
-                warm_guesses.push(*g);
-            } else {
-                jump_guesses.push(*g);
-            }
-        }
-    }
-    // Mixed states: inward friction at both edges (q > 0 on the left, q < 0 on the right)
-    // before outward; both patterns are their own mirror images, so the order does not
-    // depend on the direction of loading. At the first step of a phase (no warm start) the
-    // mixed states are what the reversal needs, and the continuations are tried in every
-    // state before the jumps to remembered boundaries; later in a phase the jumps of the
-    // standard state come first.
-    let patterns = [(sign, sign), (1.0, -1.0), (-1.0, 1.0)];
-    let mut plan = Vec::new();
-    if warm.is_none() {
-        for set in [&warm_guesses, &jump_guesses] {
-            for signs in patterns {
-                plan.extend(set.iter().map(|&g| (signs, g)));
-            }
-        }
-    } else {
-        for signs in patterns {
-            for set in [&warm_guesses, &jump_guesses] {
-                plan.extend(set.iter().map(|&g| (signs, g)));
-            }
-        }
-    }
+    let remembered = remembered_zones(memory, start, guess);
+    let (warm_guesses, jump_guesses) = distinct_guesses(guesses_in, &remembered, start.half_width);
+    let mut plan = attempt_plan(sign, warm.is_some(), &warm_guesses, &jump_guesses);
     // At a phase start, the pattern of the last phase that began mixed is tried first among
     // the attempts of its signs, with its stick end next to the edge that slips against the phase
     // where it was then (`PhaseStart`). The standard pattern's attempts still come first: where
@@ -180,27 +124,11 @@ pub fn solve_slip(
             // Within a phase the prediction continues the warm start's slip signs only.
             let first = guess == guesses_in[0] || preferred == Some((signs, guess));
             let contact = contact.filter(|_| first && warm.is_none_or(|w| w.signs == signs));
-            match solve_geometry(&problem, start, start, (guess, contact), method, options) {
-                Ok(step) => return Ok(step),
-                Err(failed) => {
-                    let retry = failed.stalled.is_some() && method.within_phase();
-                    attempts.record(failed);
-                    // A stall from a carried (or coarse) Jacobian is tried once more from a
-                    // fresh finite-difference one before the stalled iterate is taken (default
-                    // history at M = 64, 20 steps per segment, the step at −0.075 ηP of the
-                    // second cycle: stalled at 1.4e−6 after 65 evaluations, converged in 10,
-                    // 7e−6 a from the stalled state; the two other stalls of the batch in
-                    // `docs/performance.md` stay stalled, at 66 and 73 more evaluations).
-                    if retry {
-                        let fresh = Method::Broyden(None);
-                        let again = (guess, contact);
-                        if let Ok(step) =
-                            solve_geometry(&problem, start, start, again, fresh, options)
-                        {
-                            return Ok(step);
-                        }
-                    }
-                }
+            let attempt = (guess, contact);
+            if let Some(step) =
+                try_attempt(&problem, start, attempt, method, options, &mut attempts)
+            {
+                return Ok(step);
             }
         }
     }
@@ -208,6 +136,123 @@ pub fn solve_slip(
     match attempts.stalled {
         Some(step) => Ok(*step),
         None => Err(attempts.first_failure.expect("at least one attempt")),
+    }
+}
+
+/// A stick zone's ends `(lo, hi)` (m).
+type Zone = (f64, f64);
+
+/// The stick zones of the memory's turning states that lie inside `start`'s contact, as
+/// starting guesses (inset by 1e−3 a): the nested pairs of remembered stick/slip boundaries
+/// (outermost first), then the other pairs, widest first. Only the boundaries within a of
+/// the contact or of the first guess `guess` are used.
+fn remembered_zones(memory: &Memory, start: &ContactState, guess: Zone) -> Vec<Zone> {
+    let (c, a) = (start.centre, start.half_width);
+    let inset = 1e-3 * a;
+    let breaks: Vec<f64> = memory
+        .breakpoints()
+        .into_iter()
+        .filter(|&x| x > guess.0.min(c - a) - a && x < guess.1.max(c + a) + a)
+        .collect();
+    let mut remembered = Vec::new();
+    for i in 0..breaks.len() / 2 {
+        let (l, r) = (breaks[i], breaks[breaks.len() - 1 - i]);
+        if r - l > 2.0 * inset && l > c - a && r < c + a {
+            remembered.push((l + inset, r - inset));
+        }
+    }
+    // Other pairs of remembered boundaries (an earlier turning point's zone need not be
+    // nested symmetrically in the breakpoint list), widest first.
+    let mut pairs: Vec<(f64, f64)> = Vec::new();
+    for (i, &l) in breaks.iter().enumerate() {
+        for &r in &breaks[i + 1..] {
+            if r - l > 2.0 * inset && l > c - a && r < c + a {
+                pairs.push((l + inset, r - inset));
+            }
+        }
+    }
+    pairs.sort_by(|x, y| (y.1 - y.0).total_cmp(&(x.1 - x.0)));
+    remembered.extend(pairs);
+    remembered
+}
+
+/// The caller's stick-zone guesses (the continuations) and the remembered zones (the jumps),
+/// each without the guesses that repeat an earlier one to 1e−12 of the half-width `a`.
+fn distinct_guesses(guesses_in: &[Zone], remembered: &[Zone], a: f64) -> (Vec<Zone>, Vec<Zone>) {
+    let mut warm_guesses: Vec<(f64, f64)> = Vec::new();
+    let mut jump_guesses: Vec<(f64, f64)> = Vec::new();
+    for (k, g) in guesses_in.iter().chain(remembered).enumerate() {
+        let same = |h: &(f64, f64)| (h.0 - g.0).abs().max((h.1 - g.1).abs()) <= 1e-12 * a;
+        if !warm_guesses.iter().chain(&jump_guesses).any(same) {
+            if k < guesses_in.len() {
+                warm_guesses.push(*g);
+            } else {
+                jump_guesses.push(*g);
+            }
+        }
+    }
+    (warm_guesses, jump_guesses)
+}
+
+/// The attempts of a step in phase `sign`, as `(slip signs, stick-zone guess)`, in order;
+/// `warm_start` when the step is not the first of its phase.
+///
+/// Mixed states: inward friction at both edges (q > 0 on the left, q < 0 on the right)
+/// before outward; both patterns are their own mirror images, so the order does not
+/// depend on the direction of loading. At the first step of a phase (no warm start) the
+/// mixed states are what the reversal needs, and the continuations are tried in every
+/// state before the jumps to remembered boundaries; later in a phase the jumps of the
+/// standard state come first.
+fn attempt_plan(
+    sign: f64,
+    warm_start: bool,
+    warm_guesses: &[Zone],
+    jump_guesses: &[Zone],
+) -> Vec<((f64, f64), Zone)> {
+    let patterns = [(sign, sign), (1.0, -1.0), (-1.0, 1.0)];
+    let mut plan = Vec::new();
+    if warm_start {
+        for signs in patterns {
+            for set in [warm_guesses, jump_guesses] {
+                plan.extend(set.iter().map(|&g| (signs, g)));
+            }
+        }
+    } else {
+        for set in [warm_guesses, jump_guesses] {
+            for signs in patterns {
+                plan.extend(set.iter().map(|&g| (signs, g)));
+            }
+        }
+    }
+    plan
+}
+
+/// One attempt of the plan from the stick ends and the contact `attempt`; its failure goes to
+/// `attempts`. A stall from a carried (or coarse) Jacobian is tried once more from a fresh
+/// finite-difference one before the stalled iterate is taken (default history at M = 64, 20
+/// steps per segment, the step at −0.075 ηP of the second cycle: stalled at 1.4e−6 after 65
+/// evaluations, converged in 10, 7e−6 a from the stalled state; the two other stalls of the
+/// batch in `docs/performance.md` stay stalled, at 66 and 73 more evaluations).
+fn try_attempt(
+    problem: &StepProblem<'_>,
+    start: &ContactState,
+    attempt: ((f64, f64), Option<(f64, f64)>),
+    method: Method<'_>,
+    options: SlipOptions,
+    attempts: &mut Attempts,
+) -> Option<SlipStep> {
+    match solve_geometry(problem, start, start, attempt, method, options) {
+        Ok(step) => Some(step),
+        Err(failed) => {
+            let retry = failed.stalled.is_some() && method.within_phase();
+            attempts.record(failed);
+            if retry {
+                let fresh = Method::Broyden(None);
+                solve_geometry(problem, start, start, attempt, fresh, options).ok()
+            } else {
+                None
+            }
+        }
     }
 }
 
@@ -416,7 +461,6 @@ impl Method<'_> {
 /// line search. The iteration begins with the stick ends `guess` and the half-width, centre
 /// and traction of `from`; `start` is the previous step, against which the slip direction is
 /// checked.
-#[allow(clippy::needless_range_loop, clippy::too_many_arguments)]
 fn solve_geometry(
     problem: &StepProblem<'_>,
     start: &ContactState,
@@ -425,111 +469,23 @@ fn solve_geometry(
     method: Method<'_>,
     options: SlipOptions,
 ) -> Result<SlipStep, Failed> {
+    let search = GeometrySearch {
+        problem,
+        start,
+        method,
+        options,
+    };
     let (hint, quasi_newton) = match method {
         Method::Broyden(hint) => (hint, true),
         Method::Coarse => (None, true),
         Method::Recall(recalled) => (Some(recalled.warm.jacobian), true),
         Method::Newton => (None, false),
     };
-    // The recalled step and its checks, at an iterate that repeats it (`Recalled`).
-    let repeated = |g: &Geometry| match method {
-        Method::Recall(recalled) => recalled.repeated_at(g).map(|checks| (recalled, checks)),
-        _ => None,
-    };
-    let model = problem.model;
-    let (a0, c0) = contact.unwrap_or((from.half_width, from.centre));
-    let clamp_lo = |lo: f64| lo.max(c0 - a0 * (1.0 - 1e-9));
-    let clamp_hi = |hi: f64| hi.min(c0 + a0 * (1.0 - 1e-9));
-    let mut g = Geometry {
-        lo: clamp_lo(guess.0),
-        hi: clamp_hi(guess.1),
-        a: a0,
-        c: c0,
-    };
-    if !problem.valid(&g) {
-        g.lo = c0 - 0.5 * a0;
-        g.hi = c0 + 0.5 * a0;
-    }
-    // A residual from a loose inner solve is solved again at the full inner tolerance
-    // before its iterate can be accepted.
-    let solve_fully = |g: &Geometry, s: &ContactState| problem.evaluate(g, s, INNER_TOLERANCE);
-    // The first residual of an attempt is a trial iterate's whose size is not known yet: it is
-    // solved to the loosest inner tolerance (an accepted residual is solved again at the
-    // full tolerance anyway, so this saves inner passes and leaves the states unchanged).
-    let recalled = matches!(method, Method::Recall(_));
-    let first_tolerance = if recalled {
-        INNER_TOLERANCE
-    } else {
-        LOOSEST_INNER_TOLERANCE
-    };
-    let (mut r, mut state, mut tight) = problem.evaluate(&g, from, first_tolerance)?;
-    if recalled && norm(&r) > RECALL_RESIDUAL {
-        return Err(SolveFailure::NoConvergence {
-            what: "recalled step",
-            iterations: 1,
-            residual: norm(&r),
-        }
-        .into());
-    }
+    let mut g = search.starting_geometry(from, guess, contact);
+    let (mut r, mut state, mut tight) = search.first_residual(&g, from)?;
     let mut evaluations = 1;
-    let mut jac = hint;
-    // Within a phase the coarse grid's Jacobian at the first iterate replaces the carried one
-    // (`coarse_jacobian`). Its evaluations are not counted: they are the coarse grid's. It
-    // saves residual evaluations because within a phase the geometry changes little, so the
-    // coarse Jacobian at the current iterate is closer than the carried one. At a phase start
-    // the fine one is kept: there a coarse Jacobian can steer the iteration to another
-    // admissible state.
-    if options.coarse_jacobian && method.within_phase() {
-        jac = coarse_jacobian(problem, &g, &state).or(jac);
-    }
+    let mut jac = search.starting_jacobian(&g, &state, hint);
     let mut fresh = false;
-    // The state at an accepted iterate `g`: φ0, the shape table and the checks.
-    let accept = |mut state: ContactState,
-                  g: &Geometry,
-                  iterations: usize,
-                  evaluations: usize,
-                  residual: f64,
-                  jac: Option<[[f64; 4]; 4]>|
-     -> Result<SlipStep, SolveFailure> {
-        let repeated = repeated(g);
-        if state.split.conducting
-            && !matches!(
-                model.electrode,
-                crate::contact::Electrode::ConductingPotential { .. }
-            )
-        {
-            // φ0 of the accepted state (charge control; the moment does not feed back), or
-            // the recalled state's when this is that state again.
-            (state.charge, state.potential) = match repeated {
-                Some((recalled, _)) => (recalled.state.charge, recalled.state.potential),
-                None => {
-                    let j_q = arcsine_moment(&state);
-                    electric_resultants(model, g.a, problem.normal_load, j_q)
-                }
-            };
-        }
-        // The accepted state is evaluated many times from here on (checks, increments,
-        // memory): tabulate its shape quadrature once, and drop an own correction that is
-        // round-off (a return to a remembered state inherits that state whole and adds
-        // nothing; its own series, about 1e−16 of ηp0, would otherwise cost a Clenshaw sum at
-        // every later evaluation of every state whose chain holds it, one more per cycle).
-        state.tabulate_shape();
-        state.drop_negligible_correction(model.friction);
-        let admissibility = match repeated {
-            Some((_, checks)) => checks,
-            None => assess_step(model, start, &state),
-        };
-        check(&admissibility, options.admissibility)?;
-        Ok(SlipStep {
-            state,
-            iterations,
-            newton_iterations: evaluations,
-            residual,
-            admissibility,
-            jacobian: jac.unwrap_or([[0.0; 4]; 4]),
-            repeated: repeated.is_some(),
-        })
-    };
     // The projected update within a phase; at a phase start Broyden's (there the iteration's
     // path decides which of several admissible states it reaches: tried there too, the first
     // step of a PZT-4 first loading at M = 128 reached another state, 8e−5 a away).
@@ -543,23 +499,14 @@ fn solve_geometry(
         if size < options.tolerance && !tight {
             // Converged on a loose inner solve: confirm at the full inner tolerance (from the
             // loose solution, a pass or two).
-            (r, state, tight) = solve_fully(&g, &state)?;
+            (r, state, tight) = search.solve_fully(&g, &state)?;
             evaluations += 1;
             continue;
         }
         if size < options.tolerance {
-            return Ok(accept(state, &g, iter, evaluations, size, jac)?);
+            return Ok(search.accept(state, &g, (iter, evaluations), size, jac)?);
         }
-        // Newton's fallback gets a larger budget: it needs 5 evaluations per iteration. An
-        // attempt that is already within 1e4 of the tolerance is converging (attempts without
-        // a root wander at large residuals) and may take twice the budget: at the first step
-        // after the reversal of the default history at M = 128 the mixed state converged
-        // linearly to 5e−12 in the 61 evaluations allowed, and the next attempt found the same
-        // state after 38 more.
-        let near = size < 1e4 * options.tolerance;
-        let budget =
-            if quasi_newton { 1 } else { 5 } * options.max_evaluations * if near { 2 } else { 1 };
-        if evaluations > budget {
+        if evaluations > search.budget(quasi_newton, size) {
             break;
         }
         let j = match jac {
@@ -578,34 +525,8 @@ fn solve_geometry(
             jac = None;
             continue;
         };
-        let mut alpha = 1.0;
-        let mut accepted = None;
-        for _ in 0..if fresh { 30 } else { 6 } {
-            let gn = Geometry {
-                lo: g.lo + alpha * dx[0],
-                hi: g.hi + alpha * dx[1],
-                a: g.a + alpha * dx[2],
-                c: g.c + alpha * dx[3],
-            };
-            if problem.valid(&gn) {
-                // Near the tolerance the trial is solved fully, so that it can be accepted as
-                // it is (a loose one below the tolerance would be evaluated again, one fine
-                // evaluation more).
-                let inner = if near {
-                    INNER_TOLERANCE
-                } else {
-                    inner_tolerance(size)
-                };
-                let (rn, sn, full) = problem.evaluate(&gn, &state, inner)?;
-                evaluations += 1;
-                if norm(&rn) < (1.0 - 1e-4 * alpha) * size {
-                    accepted = Some((gn, rn, sn, alpha, full));
-                    break;
-                }
-            }
-            alpha *= 0.5;
-        }
-        let Some((gn, rn, sn, alpha, full)) = accepted else {
+        let trial = search.line_search(&g, &state, dx, size, fresh, &mut evaluations)?;
+        let Some(trial) = trial else {
             if fresh {
                 break;
             }
@@ -613,41 +534,292 @@ fn solve_geometry(
             continue;
         };
         // The secant update with the step taken and the change of the residuals.
-        let step = dx.map(|v| alpha * v);
+        let step = dx.map(|v| trial.alpha * v);
         let direction = if projected {
             directions.direction(step)
         } else {
             step
         };
-        let change = std::array::from_fn(|i| rn[i] - r[i]);
+        let change = std::array::from_fn(|i| trial.r[i] - r[i]);
         jac = quasi_newton.then(|| secant_update(j, step, change, direction));
         fresh = false;
-        g = gn;
-        r = rn;
-        state = sn;
-        tight = full;
+        (g, r, state, tight) = (trial.g, trial.r, trial.state, trial.full);
     }
-    // Every accepted iterate lowered the residual, so the last one is the best. A stalled
-    // iterate that may be accepted is first solved at the full inner tolerance (its inner
-    // solve may have stopped at 1e−3 of the residual before it).
-    let mut size = norm(&r);
-    if size < options.stall_tolerance && !tight {
-        (r, state, _) = solve_fully(&g, &state)?;
-        evaluations += 1;
-        size = norm(&r);
+    Err(search.stalled(g, (r, state, tight), (iterations, evaluations), jac))
+}
+
+/// What one attempt of [`solve_geometry`] works with besides its iterates.
+struct GeometrySearch<'s> {
+    problem: &'s StepProblem<'s>,
+    /// The previous step, against which the slip direction is checked.
+    start: &'s ContactState,
+    method: Method<'s>,
+    options: SlipOptions,
+}
+
+/// An iterate of the line search that lowered the residual: its geometry, residuals and
+/// state, the fraction `alpha` of the direction taken, and whether its inner solve reached
+/// the full inner tolerance.
+struct Trial {
+    g: Geometry,
+    r: [f64; 4],
+    state: ContactState,
+    alpha: f64,
+    full: bool,
+}
+
+impl GeometrySearch<'_> {
+    /// The first iterate: the stick ends `guess` (kept inside the contact) on the contact
+    /// `contact`, or `from`'s when not given; the middle half of that contact when the
+    /// guess is not a valid geometry.
+    fn starting_geometry(
+        &self,
+        from: &ContactState,
+        guess: (f64, f64),
+        contact: Option<(f64, f64)>,
+    ) -> Geometry {
+        let (a0, c0) = contact.unwrap_or((from.half_width, from.centre));
+        let clamp_lo = |lo: f64| lo.max(c0 - a0 * (1.0 - 1e-9));
+        let clamp_hi = |hi: f64| hi.min(c0 + a0 * (1.0 - 1e-9));
+        let mut g = Geometry {
+            lo: clamp_lo(guess.0),
+            hi: clamp_hi(guess.1),
+            a: a0,
+            c: c0,
+        };
+        if !self.problem.valid(&g) {
+            g.lo = c0 - 0.5 * a0;
+            g.hi = c0 + 0.5 * a0;
+        }
+        g
     }
-    let stalled = (size < options.stall_tolerance)
-        .then(|| accept(state, &g, iterations, evaluations, size, jac).ok())
-        .flatten()
-        .map(Box::new);
-    Err(Failed {
-        failure: SolveFailure::NoConvergence {
-            what: "tangential step (Newton on stick ends, a, c)",
-            iterations: evaluations,
-            residual: size,
-        },
-        stalled,
-    })
+
+    /// The Jacobian the attempt starts from at its first iterate `g` (solved as `state`):
+    /// `hint`, or within a phase the coarse grid's Jacobian there (`coarse_jacobian`), which
+    /// replaces the carried one. Its evaluations are not counted: they are the coarse grid's.
+    /// It saves residual evaluations because within a phase the geometry changes little, so
+    /// the coarse Jacobian at the current iterate is closer than the carried one; the states
+    /// are the same to the tolerance ([`SlipOptions::coarse_jacobian`]). At a phase start the
+    /// fine one is kept: there a coarse Jacobian can steer the iteration to another admissible
+    /// state.
+    fn starting_jacobian(
+        &self,
+        g: &Geometry,
+        state: &ContactState,
+        hint: Option<[[f64; 4]; 4]>,
+    ) -> Option<[[f64; 4]; 4]> {
+        if self.options.coarse_jacobian && self.method.within_phase() {
+            coarse_jacobian(self.problem, g, state).or(hint)
+        } else {
+            hint
+        }
+    }
+
+    /// The first residual of the attempt, from `from`'s traction. It is a trial iterate's
+    /// whose size is not known yet: it is solved to the loosest inner tolerance (an accepted
+    /// residual is solved again at the full tolerance anyway, so this saves inner passes and
+    /// leaves the states unchanged). A recalled step's is solved at the full tolerance, and
+    /// the attempt is given up when it exceeds [`RECALL_RESIDUAL`].
+    fn first_residual(
+        &self,
+        g: &Geometry,
+        from: &ContactState,
+    ) -> Result<([f64; 4], ContactState, bool), Failed> {
+        let recalled = matches!(self.method, Method::Recall(_));
+        let first_tolerance = if recalled {
+            INNER_TOLERANCE
+        } else {
+            LOOSEST_INNER_TOLERANCE
+        };
+        let (r, state, tight) = self.problem.evaluate(g, from, first_tolerance)?;
+        if recalled && norm(&r) > RECALL_RESIDUAL {
+            return Err(SolveFailure::NoConvergence {
+                what: "recalled step",
+                iterations: 1,
+                residual: norm(&r),
+            }
+            .into());
+        }
+        Ok((r, state, tight))
+    }
+
+    /// The residuals at `g` solved at the full inner tolerance from `state`: a residual from
+    /// a loose inner solve is solved again so before its iterate can be accepted.
+    fn solve_fully(
+        &self,
+        g: &Geometry,
+        state: &ContactState,
+    ) -> Result<([f64; 4], ContactState, bool), SolveFailure> {
+        self.problem.evaluate(g, state, INNER_TOLERANCE)
+    }
+
+    /// Whether a residual of size `size` is within 1e4 of the solver's tolerance: such an
+    /// attempt is converging (attempts without a root wander at large residuals).
+    fn near(&self, size: f64) -> bool {
+        size < 1e4 * self.options.tolerance
+    }
+
+    /// The evaluations an attempt may make at the residual `size`. Newton's fallback gets a
+    /// larger budget: it needs 5 evaluations per iteration. An attempt that is already within
+    /// 1e4 of the tolerance ([`Self::near`]) is converging and may take twice the budget: at
+    /// the first step after the reversal of the default history at M = 128 the mixed state
+    /// converged linearly to 5e−12 in the 61 evaluations allowed, and the next attempt found
+    /// the same state after 38 more.
+    fn budget(&self, quasi_newton: bool, size: f64) -> usize {
+        let near = self.near(size);
+        (if quasi_newton { 1 } else { 5 }) * self.options.max_evaluations * if near { 2 } else { 1 }
+    }
+
+    /// The inner tolerance of a trial iterate from a residual of size `size`: the inexact
+    /// Newton tolerance ([`inner_tolerance`]), which saves inner passes. Near the tolerance
+    /// ([`Self::near`]) the trial is solved fully, so that it can be accepted as it is (a
+    /// loose one below the tolerance would be evaluated again, one fine evaluation more).
+    /// Either way an iterate is accepted only on a residual solved at the full tolerance.
+    fn trial_tolerance(&self, size: f64) -> f64 {
+        if self.near(size) {
+            INNER_TOLERANCE
+        } else {
+            inner_tolerance(size)
+        }
+    }
+
+    /// Backtracking along the direction `dx` from `g` (residual size `size`): the first
+    /// fraction, halved from 1 (30 times from a fresh Jacobian, else 6), whose geometry is
+    /// valid and lowers the residual by the Armijo factor; `None` when none does. Each
+    /// evaluation is counted in `evaluations`.
+    fn line_search(
+        &self,
+        g: &Geometry,
+        state: &ContactState,
+        dx: [f64; 4],
+        size: f64,
+        fresh: bool,
+        evaluations: &mut usize,
+    ) -> Result<Option<Trial>, SolveFailure> {
+        let mut alpha = 1.0;
+        for _ in 0..if fresh { 30 } else { 6 } {
+            let gn = Geometry {
+                lo: g.lo + alpha * dx[0],
+                hi: g.hi + alpha * dx[1],
+                a: g.a + alpha * dx[2],
+                c: g.c + alpha * dx[3],
+            };
+            if self.problem.valid(&gn) {
+                let inner = self.trial_tolerance(size);
+                let (rn, sn, full) = self.problem.evaluate(&gn, state, inner)?;
+                *evaluations += 1;
+                if norm(&rn) < (1.0 - 1e-4 * alpha) * size {
+                    return Ok(Some(Trial {
+                        g: gn,
+                        r: rn,
+                        state: sn,
+                        alpha,
+                        full,
+                    }));
+                }
+            }
+            alpha *= 0.5;
+        }
+        Ok(None)
+    }
+
+    /// The recalled step and its checks, at an iterate `g` that repeats it ([`Recalled`]):
+    /// its charge, potential and checks are then taken instead of evaluated, which saves
+    /// those evaluations; the step is the recalled one again to the solver's tolerance.
+    fn repeated(&self, g: &Geometry) -> Option<(&Recalled, StepAdmissibility)> {
+        match self.method {
+            Method::Recall(recalled) => recalled.repeated_at(g).map(|checks| (recalled, checks)),
+            _ => None,
+        }
+    }
+
+    /// The step at an accepted iterate `g`: φ0, the shape table and the checks.
+    fn accept(
+        &self,
+        mut state: ContactState,
+        g: &Geometry,
+        (iterations, evaluations): (usize, usize),
+        residual: f64,
+        jac: Option<[[f64; 4]; 4]>,
+    ) -> Result<SlipStep, SolveFailure> {
+        let model = self.problem.model;
+        let repeated = self.repeated(g);
+        if state.split.conducting
+            && !matches!(
+                model.electrode,
+                crate::contact::Electrode::ConductingPotential { .. }
+            )
+        {
+            // φ0 of the accepted state (charge control; the moment does not feed back), or
+            // the recalled state's when this is that state again.
+            (state.charge, state.potential) = match repeated {
+                Some((recalled, _)) => (recalled.state.charge, recalled.state.potential),
+                None => {
+                    let j_q = arcsine_moment(&state);
+                    electric_resultants(model, g.a, self.problem.normal_load, j_q)
+                }
+            };
+        }
+        // The accepted state is evaluated many times from here on (checks, increments,
+        // memory): tabulate its shape quadrature once, and drop an own correction that is
+        // round-off (a return to a remembered state inherits that state whole and adds
+        // nothing; its own series, about 1e−16 of ηp0, would otherwise cost a Clenshaw sum at
+        // every later evaluation of every state whose chain holds it, one more per cycle).
+        state.tabulate_shape();
+        state.drop_negligible_correction(model.friction);
+        let admissibility = match repeated {
+            Some((_, checks)) => checks,
+            None => assess_step(model, self.start, &state),
+        };
+        check(&admissibility, self.options.admissibility)?;
+        Ok(SlipStep {
+            state,
+            iterations,
+            newton_iterations: evaluations,
+            residual,
+            admissibility,
+            jacobian: jac.unwrap_or([[0.0; 4]; 4]),
+            repeated: repeated.is_some(),
+        })
+    }
+
+    /// The failure of an attempt whose iteration ended at `g` without converging, with its
+    /// stalled step when that is admissible. Every accepted iterate lowered the residual, so
+    /// the last one is the best. A stalled iterate that may be accepted is first solved at the
+    /// full inner tolerance (its inner solve may have stopped at 1e−3 of the residual before
+    /// it).
+    fn stalled(
+        &self,
+        g: Geometry,
+        (mut r, mut state, tight): ([f64; 4], ContactState, bool),
+        (iterations, mut evaluations): (usize, usize),
+        jac: Option<[[f64; 4]; 4]>,
+    ) -> Failed {
+        let mut size = norm(&r);
+        if size < self.options.stall_tolerance && !tight {
+            (r, state, _) = match self.solve_fully(&g, &state) {
+                Ok(solved) => solved,
+                Err(failure) => return failure.into(),
+            };
+            evaluations += 1;
+            size = norm(&r);
+        }
+        let stalled = (size < self.options.stall_tolerance)
+            .then(|| {
+                self.accept(state, &g, (iterations, evaluations), size, jac)
+                    .ok()
+            })
+            .flatten()
+            .map(Box::new);
+        Failed {
+            failure: SolveFailure::NoConvergence {
+                what: "tangential step (Newton on stick ends, a, c)",
+                iterations: evaluations,
+                residual: size,
+            },
+            stalled,
+        }
+    }
 }
 
 #[cfg(test)]
