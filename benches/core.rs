@@ -341,60 +341,123 @@ fn steady_cycle(c: &mut Criterion) {
     bench_cycle(c, "cycle/repeated_cycle", 2);
 }
 
-/// The general element solver on the default contact (PZT-4, conducting punch, η = 0.3,
-/// P = 2000 N/m): elements of 5e−4 a at the contact ends growing by 8 % to 1e−2 a inside, after
-/// an incremental normal loading with P and Γ rising together. `general/tangential_step` takes
-/// Q from 0 to 0.05 ηP in one step (issue 37's target for it is 20 ms);
-/// `general/history_20_steps` runs 20 consecutive steps, Q up to 0.5 ηP in steps of 0.05 ηP and
-/// back down to 0, each from the previous state (divide by 20 for the cost of a step).
-fn general_step(c: &mut Criterion) {
+/// The general element solver on a contact loaded normally with P and the electric load rising
+/// together (P ∝ f², Γ or φ0 ∝ f), on elements of 5e−4 a at the contact ends growing by 8 % to
+/// 1e−2 a inside; `electric` is the charge Γ or the potential φ0 at full load.
+fn general_loaded(
+    model: &fretsim::contact::ContactModel,
+    normal_load: f64,
+    electric: f64,
+) -> (
+    fretsim::contact::general::Solver,
+    fretsim::contact::general::GeneralState,
+) {
     use fretsim::contact::general::mesh::{Focus, Mesh};
     use fretsim::contact::general::{GeneralState, Loads, Options, Solver};
-    let sc = default_scenario();
     let disc = Discretisation::new(64);
-    let normal = solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
+    let normal = solve_normal(model, &disc, normal_load, NormalOptions::default()).unwrap();
     let a = normal.state.half_width;
-    let gamma = normal.state.charge;
     let focus = [Focus {
         at: a,
         size: 5e-4 * a,
     }];
     let solver = Solver::new(
-        &sc.model,
+        model,
         Mesh::symmetric(1.1 * a, &focus, 1.08, 1e-2 * a),
         Options::default(),
     );
-    let at = |f: f64, q: f64| Loads {
-        normal: sc.normal_load * f,
-        tangential: q,
-        electric: gamma * f,
-    };
     let mut state = GeneralState::unloaded(solver.mesh().clone());
     for k in 1..=20 {
         let f = k as f64 / 20.0;
-        state = solver.step(&state, at(f * f, 0.0)).unwrap().0;
+        let loads = Loads {
+            normal: normal_load * f * f,
+            tangential: 0.0,
+            electric: electric * f,
+        };
+        state = solver.step(&state, loads).unwrap().0;
     }
+    (solver, state)
+}
+
+/// 20 consecutive general steps from `state`: Q up to 0.5 ηP in steps of 0.05 ηP and back
+/// down to 0, each from the previous state.
+fn general_history(
+    solver: &fretsim::contact::general::Solver,
+    state: &fretsim::contact::general::GeneralState,
+    friction: f64,
+) -> fretsim::contact::general::GeneralState {
+    use fretsim::contact::general::Loads;
+    let eta_p = friction * state.loads.normal;
+    let mut s = state.clone();
+    for k in 1..=20_i32 {
+        let q = 0.05 * eta_p * f64::from(10 - (10 - k).abs());
+        s = solver
+            .step(
+                &s,
+                Loads {
+                    tangential: q,
+                    ..s.loads
+                },
+            )
+            .unwrap()
+            .0;
+    }
+    s
+}
+
+/// The general element solver on the default contact (PZT-4, conducting punch, η = 0.3,
+/// P = 2000 N/m; [`general_loaded`]). `general/tangential_step` takes Q from 0 to 0.05 ηP in
+/// one step (issue 37's target for it is 20 ms); `general/history_20_steps` runs
+/// [`general_history`] (divide by 20 for the cost of a step). `general/strong_coupling_20_steps`
+/// runs the same history on the contacts where the electric coupling is strongest, at
+/// η = 0.5: the punch at the potential φ0 = −86.10 V (`potential`, the potential of the charge
+/// 2Γ1) and the punch carrying Γ = 1.5Γ1 = 7.503e−7 C/m (`charge_1.5G1`).
+fn general_step(c: &mut Criterion) {
+    use fretsim::contact::Electrode;
+    use fretsim::contact::general::Loads;
+    let sc = default_scenario();
+    let (solver, state) = general_loaded(&sc.model, sc.normal_load, 6e-7);
     let eta_p = sc.model.friction * sc.normal_load;
     let mut g = c.benchmark_group("general/tangential_step");
     g.sample_size(10);
     g.bench_function(BenchmarkId::from_parameter(solver.mesh().len()), |b| {
-        b.iter(|| black_box(solver.step(&state, at(1.0, 0.05 * eta_p)).unwrap()))
+        b.iter(|| {
+            let loads = Loads {
+                tangential: 0.05 * eta_p,
+                ..state.loads
+            };
+            black_box(solver.step(&state, loads).unwrap())
+        })
     });
     g.finish();
-    let history: Vec<f64> = (1..=20)
-        .map(|k: i32| 0.05 * eta_p * f64::from(10 - (10 - k).abs()))
-        .collect();
     let mut g = c.benchmark_group("general/history_20_steps");
     g.sample_size(10);
     g.bench_function(BenchmarkId::from_parameter(solver.mesh().len()), |b| {
-        b.iter(|| {
-            let mut s = state.clone();
-            for &q in &history {
-                s = solver.step(&s, at(1.0, q)).unwrap().0;
-            }
-            black_box(s)
-        })
+        b.iter(|| black_box(general_history(&solver, &state, sc.model.friction)))
     });
+    g.finish();
+    let mut g = c.benchmark_group("general/strong_coupling_20_steps");
+    g.sample_size(10);
+    for (name, electrode, electric) in [
+        (
+            "potential",
+            Electrode::ConductingPotential { potential: -86.10 },
+            -86.10,
+        ),
+        (
+            "charge_1.5G1",
+            Electrode::ConductingCharge { charge: 7.503e-7 },
+            7.503e-7,
+        ),
+    ] {
+        let mut model = sc.model.clone();
+        model.electrode = electrode;
+        model.friction = 0.5;
+        let (solver, state) = general_loaded(&model, sc.normal_load, electric);
+        g.bench_function(BenchmarkId::from_parameter(name), |b| {
+            b.iter(|| black_box(general_history(&solver, &state, model.friction)))
+        });
+    }
     g.finish();
 }
 
