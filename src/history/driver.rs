@@ -192,7 +192,8 @@ pub fn finish_step(
 }
 
 /// Solve one load step and commit its state to the driver (phase, memory, anchor, warm
-/// start); its increments are left to [`finish_step`].
+/// start): [`try_step`], then [`DriverState::commit`]; its increments are left to
+/// [`finish_step`].
 pub fn solve_step(
     model: &ContactModel,
     disc: &Discretisation,
@@ -200,24 +201,174 @@ pub fn solve_step(
     point: LoadPoint,
     options: SlipOptions,
 ) -> Result<Solved, StepFailure> {
+    Ok(match try_step(model, disc, driver, point, options)? {
+        Tried::Hold(regime) => Solved::Hold(regime),
+        Tried::Slip(trial) => Solved::Slip(Box::new(driver.commit(*trial))),
+    })
+}
+
+/// A step tried from the committed state: a hold, or a slip step to commit
+/// ([`DriverState::commit`]) or drop.
+pub enum Tried {
+    /// ΔQ = 0 (the regime is [`Regime::Stick`]): nothing changes.
+    Hold(Regime),
+    /// A solved slip step.
+    Slip(Box<Trial>),
+}
+
+/// A slip step solved from the committed state, not yet committed: its state, and what the
+/// commit stores with it.
+pub struct Trial {
+    point: LoadPoint,
+    regime: Regime,
+    sign: f64,
+    /// The solver's step.
+    pub solved: SlipStep,
+    /// The phase the step begins, if it begins one: the memory it keeps, its base zone and the
+    /// load it begins at.
+    begins: Option<PhaseBegin>,
+    /// `[Q, lo, hi, a, c]` of the state the step's phase began from.
+    phase_start: Option<[f64; 5]>,
+    /// The same step of the last phase in this direction from the same turning state.
+    traced: Option<TraceStep>,
+    /// The footprint of the state the step began from.
+    from: super::hints::Footprint,
+    /// Whether the step converged to the tolerance (only such steps are traced).
+    converged: bool,
+}
+
+/// What a step that begins a phase stores.
+struct PhaseBegin {
+    memory: Memory,
+    base: Option<Arc<crate::contact::StickZone>>,
+    start_load: f64,
+}
+
+impl Trial {
+    /// The record the step will have once committed to `driver` (the driver it was tried
+    /// from), without its increments.
+    pub fn record(&self, driver: &DriverState) -> StepRecord {
+        let mut preview = record(
+            self.point.step,
+            self.point.t,
+            driver,
+            self.regime,
+            Some(&self.solved),
+        );
+        let s = &self.solved.state;
+        let stick = s.traction.stick.as_ref().expect("slip state");
+        preview.phase = driver.phase + usize::from(self.begins.is_some());
+        preview.q = s.tangential_load;
+        preview.half_width = s.half_width;
+        preview.eccentricity = -s.centre;
+        preview.stick_lo = stick.lo;
+        preview.stick_hi = stick.hi;
+        preview.left_slip_sign = s.traction.left_sign;
+        preview.right_slip_sign = s.traction.right_sign;
+        preview.zones = ZoneCount::of_spectral(s);
+        preview
+    }
+}
+
+/// Solve one load step from the driver's committed state, which it leaves as it is (but for
+/// the tables of the turning state, built once a phase begins from it).
+///
+/// The step's regime follows from ΔQ ([`next_regime`]) and whether it begins a phase from
+/// the phase rule ([`phase_event`]). A phase stores the memory of the turning state
+/// ([`Memory::committed`]); its first step starts from the Mindlin–Deresiewicz guess
+/// (`phase_start_guess`), the others from the geometry extrapolated in Q (`predict`), the
+/// previous Jacobian and the recalled step of a repeated phase (module docs).
+pub fn try_step(
+    model: &ContactModel,
+    disc: &Discretisation,
+    driver: &DriverState,
+    point: LoadPoint,
+    options: SlipOptions,
+) -> Result<Tried, StepFailure> {
     let LoadPoint { step, t, q } = point;
     let dq = q - driver.state.tangential_load;
     let limit = model.friction * driver.state.normal_load;
     let regime = next_regime(dq, 1e-12 * limit);
     let Some(sign) = regime.slip_sign() else {
-        return Ok(Solved::Hold(regime));
+        return Ok(Tried::Hold(regime));
     };
     let new_phase = matches!(phase_event(driver.phase_sign, regime), PhaseEvent::Begin(_));
-    let predicted = (!new_phase).then(|| predict(&driver.history, q)).flatten();
-    let guess = if new_phase {
-        phase_start_guess(model, &driver.state, sign, dq)
-    } else {
-        match predicted {
-            Some([lo, hi, ..]) => (lo, hi),
-            None => phase_start_guess(model, &driver.state, sign, dq),
-        }
+    let begins = new_phase.then(|| begin_phase(disc, driver));
+    let (memory, base, start_load) = match &begins {
+        Some(b) => (&b.memory, b.base.as_ref(), b.start_load),
+        None => (
+            &driver.memory,
+            driver.base.as_ref(),
+            driver.phase_start_load,
+        ),
     };
-    if new_phase && let Some(zone) = driver.state.traction.stick.as_ref() {
+    let (guesses, contact) = starting_geometry(model, driver, (q, sign, dq), new_phase, start_load);
+    // The same step of the last phase in this direction that began from the same turning
+    // state: in a steady cycle it solves this step again.
+    let phase_start = if new_phase {
+        Some(load_and_geometry(&driver.state))
+    } else {
+        driver.traces.current.as_ref().map(|t| t.start)
+    };
+    let traced = phase_start
+        .filter(|_| options.recall)
+        .and_then(|start| driver.traces.recall(&start, sign, q, limit))
+        .cloned();
+    // The recalled step's checks go with it when this step begins from its start.
+    let from = footprint(&driver.state);
+    let recalled = traced.as_ref().map(|t| Recalled {
+        admissibility: t
+            .recalled
+            .admissibility
+            .filter(|_| t.increments.began_from(from)),
+        ..t.recalled.clone()
+    });
+    let solved: SlipStep = solve_slip(
+        model,
+        disc,
+        memory,
+        base,
+        &driver.state,
+        q,
+        sign,
+        &guesses,
+        contact,
+        if new_phase {
+            None
+        } else {
+            driver.warm.as_ref()
+        },
+        recalled.as_ref(),
+        driver.last_start.as_ref().filter(|_| new_phase),
+        options,
+    )
+    .map_err(|failure| StepFailure {
+        step,
+        t,
+        q,
+        regime,
+        failure,
+    })?;
+    // A step accepted at a stalled residual is not recalled: the next cycle's step tries to
+    // converge (default history at M = 64 with 20 steps per segment: the step at −0.075 ηP
+    // stalled at 1.4e−6 in the second cycle and converged from its own path in the third).
+    let converged = solved.residual < options.tolerance;
+    Ok(Tried::Slip(Box::new(Trial {
+        point,
+        regime,
+        sign,
+        solved,
+        begins,
+        phase_start,
+        traced,
+        from,
+        converged,
+    })))
+}
+
+/// The memory, base and starting load of a phase that begins from the driver's state.
+fn begin_phase(disc: &Discretisation, driver: &DriverState) -> PhaseBegin {
+    if let Some(zone) = driver.state.traction.stick.as_ref() {
         // The turning state is about to be cloned into the memory and into the new phase's
         // base, and both are evaluated at every residual evaluation of the phase: tabulate its
         // H'q̃ and q̃ first, so that the clones share one table (`StickZone::tabulate`; the
@@ -228,31 +379,40 @@ pub fn solve_step(
         // ends the same to 1e−13 of themselves).
         zone.tabulate(disc.nodes() + 32);
     }
-    let memory = if new_phase {
-        match (&driver.phase_sign, driver.state.traction.stick.as_ref()) {
-            (None, _) => driver.memory.clone(),
-            (Some(_), Some(s)) => {
-                driver
-                    .memory
-                    .committed(Arc::new(driver.state.clone()), s.lo, s.hi)
-            }
-            (Some(_), None) => driver.memory.clone(),
-        }
-    } else {
-        driver.memory.clone()
+    let memory = match (&driver.phase_sign, driver.state.traction.stick.as_ref()) {
+        (Some(_), Some(s)) => driver
+            .memory
+            .committed(Arc::new(driver.state.clone()), s.lo, s.hi),
+        _ => driver.memory.clone(),
     };
-    let base = if new_phase {
-        driver.state.traction.stick.clone().map(Arc::new)
-    } else {
-        driver.base.clone()
+    PhaseBegin {
+        memory,
+        base: driver.state.traction.stick.clone().map(Arc::new),
+        start_load: driver.state.tangential_load,
+    }
+}
+
+/// Two guesses of the stick ends `(lo, hi)`, in the order they are tried, and the contact's
+/// half-width and centre `(a, c)` to start from, when known.
+type StartingGeometry = ([(f64, f64); 2], Option<(f64, f64)>);
+
+/// The stick-end guesses of a step to load `q` (slip sign `sign`, load change `dq`) and the
+/// contact's half-width and centre to start from (module docs, "Warm start").
+fn starting_geometry(
+    model: &ContactModel,
+    driver: &DriverState,
+    (q, sign, dq): (f64, f64, f64),
+    new_phase: bool,
+    start_load: f64,
+) -> StartingGeometry {
+    let limit = model.friction * driver.state.normal_load;
+    let predicted = (!new_phase).then(|| predict(&driver.history, q)).flatten();
+    let guess = match predicted {
+        Some([lo, hi, ..]) => (lo, hi),
+        None => phase_start_guess(model, &driver.state, sign, dq),
     };
     // Second guess: the Mindlin–Deresiewicz size for the load change since the phase began,
     // centred on the contact.
-    let start_load = if new_phase {
-        driver.state.tangential_load
-    } else {
-        driver.phase_start_load
-    };
     let (c, a) = (driver.state.centre, driver.state.half_width);
     let md = (1.0 - ((q - start_load).abs() / (2.0 * limit)).min(0.95)).sqrt();
     let md_guess = (c - a * md, c + a * md);
@@ -278,70 +438,103 @@ pub fn solve_step(
     } else {
         predicted.map(|[.., a, c]| (a, c))
     };
-    // The same step of the last phase in this direction that began from the same turning
-    // state: in a steady cycle it solves this step again.
-    let phase_start = if new_phase {
-        Some(load_and_geometry(&driver.state))
-    } else {
-        driver.traces.current.as_ref().map(|t| t.start)
-    };
-    let traced = phase_start
-        .filter(|_| options.recall)
-        .and_then(|start| driver.traces.recall(&start, sign, q, limit))
-        .cloned();
-    // The recalled step's checks go with it when this step begins from its start.
-    let from = footprint(&driver.state);
-    let recalled = traced.as_ref().map(|t| Recalled {
-        admissibility: t
-            .recalled
-            .admissibility
-            .filter(|_| t.increments.began_from(from)),
-        ..t.recalled.clone()
-    });
-    let solved: SlipStep = solve_slip(
-        model,
-        disc,
-        &memory,
-        base.as_ref(),
-        &driver.state,
-        q,
-        sign,
-        &guesses,
-        contact,
-        if new_phase {
-            None
-        } else {
-            driver.warm.as_ref()
-        },
-        recalled.as_ref(),
-        driver.last_start.as_ref().filter(|_| new_phase),
-        options,
-    )
-    .map_err(|failure| StepFailure {
-        step,
-        t,
-        q,
-        regime,
-        failure,
-    })?;
-    if new_phase {
-        if let Some(start) = PhaseStart::of(&solved.state, sign) {
-            driver.last_start = Some(start);
+    (guesses, contact)
+}
+
+impl DriverState {
+    /// Commit a step tried from this state ([`try_step`]): the phase it begins (memory, base,
+    /// phase number), the anchor of δ, the warm start and predictor of the next step, and the
+    /// trace of the phase. Its increments are left to [`finish_step`].
+    pub fn commit(&mut self, trial: Trial) -> SolvedStep {
+        let Trial {
+            point,
+            regime,
+            sign,
+            solved,
+            begins,
+            phase_start,
+            traced,
+            from,
+            converged,
+        } = trial;
+        let new_phase = begins.is_some();
+        if let Some(PhaseBegin {
+            memory,
+            base,
+            start_load,
+        }) = begins
+        {
+            if let Some(start) = PhaseStart::of(&solved.state, sign) {
+                self.last_start = Some(start);
+            }
+            let dq = point.q - self.state.tangential_load;
+            self.first_centre_slope = Some((solved.state.centre - self.state.centre) / dq);
+            self.phase += 1;
+            self.phase_start_load = start_load;
+            self.phase_sign = Some(sign);
+            self.memory = memory;
+            self.base = base;
+            self.history.clear();
         }
-        driver.first_centre_slope = Some((solved.state.centre - c) / dq);
-        driver.phase += 1;
-        driver.phase_start_load = start_load;
-        driver.phase_sign = Some(sign);
-        driver.memory = memory;
-        driver.base = base;
-        driver.history.clear();
+        self.move_anchor(&solved.state);
+        self.warm = Some(WarmStart {
+            signs: (
+                solved.state.traction.left_sign,
+                solved.state.traction.right_sign,
+            ),
+            jacobian: solved.jacobian,
+        });
+        // A step that repeated the recalled one, with the same anchor, has its increments
+        // (module docs, "Recall of a repeated phase").
+        let known = traced
+            .filter(|_| solved.repeated)
+            .and_then(|t| t.increments.for_repeat(self.anchor));
+        let old = std::mem::replace(&mut self.state, solved.state.clone());
+        self.history.push(load_and_geometry(&self.state));
+        if self.history.len() > HISTORY_POINTS {
+            self.history.remove(0);
+        }
+        let record = record(point.step, point.t, self, regime, Some(&solved));
+        let new = Arc::new(solved.state);
+        let increments = Arc::new(OnceLock::new());
+        let trace = converged.then(|| TraceStep {
+            q: point.q,
+            recalled: Recalled {
+                state: Arc::clone(&new),
+                warm: self.warm.expect("set above"),
+                admissibility: Some(solved.admissibility),
+            },
+            increments: TracedIncrements {
+                from,
+                value: Arc::clone(&increments),
+            },
+        });
+        self.traces
+            .push(phase_start.filter(|_| new_phase), sign, trace);
+        SolvedStep {
+            record,
+            inputs: IncrementInputs {
+                old: Arc::new(old),
+                new,
+                anchor: self.anchor,
+                old_ux: None,
+                old_approach: None,
+            },
+            new_phase: new_phase.then(|| (self.phase, self.memory.clone())),
+            known,
+            trace: converged.then_some(increments),
+        }
     }
-    // Keep the anchor of δ while it sticks; otherwise take the middle of the part of the old
-    // stick zone that still sticks.
-    let new_zone = solved.state.traction.stick.as_ref().expect("slip state");
-    let margin = 1e-3 * (new_zone.hi - new_zone.lo);
-    if !(driver.anchor > new_zone.lo + margin && driver.anchor < new_zone.hi - margin) {
-        let (lo, hi) = driver
+
+    /// Keep the anchor of δ while it sticks in the new state; otherwise take the middle of the
+    /// part of the old stick zone that still sticks.
+    fn move_anchor(&mut self, new: &ContactState) {
+        let new_zone = new.traction.stick.as_ref().expect("slip state");
+        let margin = 1e-3 * (new_zone.hi - new_zone.lo);
+        if self.anchor > new_zone.lo + margin && self.anchor < new_zone.hi - margin {
+            return;
+        }
+        let (lo, hi) = self
             .state
             .traction
             .stick
@@ -349,64 +542,12 @@ pub fn solve_step(
             .map_or((new_zone.lo, new_zone.hi), |z| {
                 (z.lo.max(new_zone.lo), z.hi.min(new_zone.hi))
             });
-        driver.anchor = if hi > lo {
+        self.anchor = if hi > lo {
             0.5 * (lo + hi)
         } else {
             new_zone.mid()
         };
     }
-    driver.warm = Some(WarmStart {
-        signs: (
-            solved.state.traction.left_sign,
-            solved.state.traction.right_sign,
-        ),
-        jacobian: solved.jacobian,
-    });
-    // A step that repeated the recalled one, with the same anchor, has its increments
-    // (module docs, "Recall of a repeated phase").
-    let known = traced
-        .filter(|_| solved.repeated)
-        .and_then(|t| t.increments.for_repeat(driver.anchor));
-    let old = std::mem::replace(&mut driver.state, solved.state.clone());
-    driver.history.push(load_and_geometry(&driver.state));
-    if driver.history.len() > HISTORY_POINTS {
-        driver.history.remove(0);
-    }
-    let record = record(step, t, driver, regime, Some(&solved));
-    let new = Arc::new(solved.state);
-    // A step accepted at a stalled residual is not recalled: the next cycle's step tries to
-    // converge (default history at M = 64 with 20 steps per segment: the step at −0.075 ηP
-    // stalled at 1.4e−6 in the second cycle and converged from its own path in the third).
-    let converged = solved.residual < options.tolerance;
-    let increments = Arc::new(OnceLock::new());
-    let trace = converged.then(|| TraceStep {
-        q,
-        recalled: Recalled {
-            state: Arc::clone(&new),
-            warm: driver.warm.expect("set above"),
-            admissibility: Some(solved.admissibility),
-        },
-        increments: TracedIncrements {
-            from,
-            value: Arc::clone(&increments),
-        },
-    });
-    driver
-        .traces
-        .push(phase_start.filter(|_| new_phase), sign, trace);
-    Ok(Solved::Slip(Box::new(SolvedStep {
-        record,
-        inputs: IncrementInputs {
-            old: Arc::new(old),
-            new,
-            anchor: driver.anchor,
-            old_ux: None,
-            old_approach: None,
-        },
-        new_phase: new_phase.then(|| (driver.phase, driver.memory.clone())),
-        known,
-        trace: converged.then_some(increments),
-    })))
 }
 
 /// The record of the driver's committed state, with zero increments (a hold's; a slip step's

@@ -241,6 +241,10 @@ pub struct GeneralRun {
     /// The works of P and of the electric load summed over the steps taken (J/m), and those of
     /// the last step.
     works: [[f64; 2]; 2],
+    /// Steps after which the spectral solver next tries to take the state back (within the
+    /// phase of the handover): 1, then doubled after each try that fails, so that a phase the
+    /// spectral solver cannot represent costs a few of its attempts, not one a step.
+    resume_at: usize,
 }
 
 /// A [`GeneralRun`] as written (without its solver).
@@ -254,6 +258,7 @@ pub struct GeneralRunData {
     steps: usize,
     first_began_at_handover: bool,
     works: [[f64; 2]; 2],
+    resume_at: usize,
 }
 
 /// The loads of a state at tangential load `q`.
@@ -309,6 +314,7 @@ impl GeneralRun {
             steps: 0,
             first_began_at_handover: false,
             works: [[0.0; 2]; 2],
+            resume_at: 1,
         }
     }
 
@@ -325,7 +331,19 @@ impl GeneralRun {
             steps: data.steps,
             first_began_at_handover: data.first_began_at_handover,
             works: data.works,
+            resume_at: data.resume_at,
         }
+    }
+
+    /// Whether the spectral solver is due to try to take the state back after this run's
+    /// last step (see `resume_at`).
+    pub fn resume_due(&self) -> bool {
+        self.steps >= self.resume_at
+    }
+
+    /// A try to take the state back failed: the next one after twice as many steps.
+    pub fn resume_failed(&mut self) {
+        self.resume_at = 2 * self.steps.max(1);
     }
 
     /// The solver.

@@ -93,7 +93,7 @@ impl TracedIncrements {
 /// that began a traced step and the state a later step begins from are the same state when
 /// their footprints are equal (the later one a repeat of the earlier, accepted at its geometry
 /// without iterating).
-type Footprint = [u64; 6];
+pub(super) type Footprint = [u64; 6];
 
 pub(super) fn footprint(state: &ContactState) -> Footprint {
     let [_, lo, hi, a, c] = load_and_geometry(state);

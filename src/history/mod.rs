@@ -79,7 +79,9 @@ mod regime;
 mod run;
 mod state;
 
-pub use driver::{DriverState, Solved, SolvedStep, advance, finish_step, solve_step};
+pub use driver::{
+    DriverState, Solved, SolvedStep, Trial, Tried, advance, finish_step, solve_step, try_step,
+};
 pub use general::{GeneralRun, GeneralRunData, RunOptions, SolverChoice, SolverKind, ZoneCount};
 pub use increments::{IncrementInputs, StepIncrements, step_dissipation};
 pub use load::{LoadHistory, LoadPoint};

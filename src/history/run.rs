@@ -8,9 +8,7 @@ use crate::contact::normal::NormalLoading;
 use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
 
-use super::driver::{
-    DriverState, Solved, SolvedStep, finish_step, hold_record, record, solve_step,
-};
+use super::driver::{DriverState, SolvedStep, Tried, finish_step, hold_record, record, try_step};
 use super::general::{GeneralRun, RunOptions, SolverChoice, ZoneCount};
 use super::increments::{IncrementInputs, StepIncrements};
 use super::load::{LoadHistory, LoadPoint};
@@ -129,7 +127,7 @@ pub fn continue_run(
     while next < points.len() {
         let point = points[next];
         let driver = &mut state.driver;
-        let (run, step) = match state.general.take() {
+        let (mut run, step) = match state.general.take() {
             Some(mut run) => {
                 let step = run.step(model, point);
                 (run, step)
@@ -170,7 +168,7 @@ pub fn continue_run(
                 model,
                 disc,
                 driver,
-                &run,
+                &mut run,
                 (points[next], &record),
                 options.slip,
             ),
@@ -218,7 +216,7 @@ fn resumes(
     model: &ContactModel,
     disc: &Discretisation,
     driver: &mut DriverState,
-    run: &GeneralRun,
+    run: &mut GeneralRun,
     (point, last): (LoadPoint, &StepRecord),
     options: SlipOptions,
 ) -> Option<StepIncrements> {
@@ -227,19 +225,21 @@ fn resumes(
     if !same_phase || last.regime.slip_sign().is_none() {
         return None;
     }
-    let mut trial = driver.clone();
-    let Ok(Solved::Slip(solved)) = solve_step(model, disc, &mut trial, point, options) else {
-        return None;
-    };
-    let spectral = record(point.step, point.t, &trial, last.regime, None);
-    if !agrees(run, last, &spectral) {
+    if !run.resume_due() {
         return None;
     }
+    let trial = match try_step(model, disc, driver, point, options) {
+        Ok(Tried::Slip(trial)) if agrees(run, last, &trial.record(driver)) => trial,
+        _ => {
+            run.resume_failed();
+            return None;
+        }
+    };
+    let solved = driver.commit(*trial);
     let increments = solved
         .known_increments()
-        .unwrap_or_else(|| StepIncrements::compute(model, &solved.increment_inputs(&trial)));
-    finish_step(&mut trial, *solved, increments, &mut NoObserver);
-    *driver = trial;
+        .unwrap_or_else(|| StepIncrements::compute(model, &solved.increment_inputs(driver)));
+    finish_step(driver, solved, increments, &mut NoObserver);
     Some(increments)
 }
 
@@ -301,30 +301,30 @@ fn spectral_stretch(
         };
         let mut pending: Option<Box<SolvedStep>> = None;
         for (k, &point) in points.iter().enumerate() {
-            // The state before a step that begins a phase, kept for the general solver's check.
-            let before =
-                (options.check_phase_starts && begins_phase(model, driver, point)).then(|| {
-                    finish(pending.take(), driver, records, observer);
-                    driver.clone()
-                });
-            let solved = solve_step(model, disc, driver, point, options.slip);
+            // The first step of a phase is checked by the general solver from the state before
+            // it (with the previous step finished: the general run starts from its δ).
+            let check = options.check_phase_starts && begins_phase(model, driver, point);
+            if check {
+                finish(pending.take(), driver, records, observer);
+            }
+            let tried = try_step(model, disc, driver, point, options.slip);
             finish(pending.take(), driver, records, observer);
-            if let (Some(before), Ok(Solved::Slip(step))) = (before, &solved)
+            if let (true, Ok(Tried::Slip(trial))) = (check, &tried)
                 && let Some((failure, taken)) =
-                    contradicted(model, &before, (point, options), step.record())
+                    contradicted(model, driver, (point, options), &trial.record(driver))
             {
-                *driver = before;
                 return Some(Stop {
                     at: k,
                     failure,
                     taken: Some(taken),
                 });
             }
-            match solved {
-                Ok(Solved::Hold(regime)) => {
+            match tried {
+                Ok(Tried::Hold(regime)) => {
                     records.push(hold_record(driver, point, regime, observer));
                 }
-                Ok(Solved::Slip(solved)) => {
+                Ok(Tried::Slip(trial)) => {
+                    let solved = Box::new(driver.commit(*trial));
                     if solved.known_increments().is_none() {
                         jobs.send(solved.increment_inputs(driver))
                             .expect("the increments worker runs until the steps end");
