@@ -16,7 +16,7 @@ use super::{
 /// The stick zone `[lo, hi]` and the bounded correction `q̃` on it.
 ///
 /// Written as plain data: its tables as the number of points they were built with, rebuilt
-/// from the zone when it is read ([`StickZoneData`]), so a zone read back evaluates to the bit
+/// from the zone when it is read (`StickZoneData`), so a zone read back evaluates to the bit
 /// as the one written.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(from = "StickZoneData")]

@@ -13,9 +13,20 @@
 //!
 //! # Steps
 //! Each segment `(t0, Q0) → (t1, Q1)` is cut into `max(steps_per_segment, ⌈|ΔQ|/max_step⌉)`
-//! equal steps. Each step is solved by [`solve_slip`] from the committed state and memory,
-//! checked, and only then committed (trial, then commit). A failure stops the run with the
-//! step, t, Q and regime; the steps already solved are kept by the caller (observer).
+//! equal steps ([`LoadHistory::load_points`]). Each step is tried by [`try_step`] from the
+//! committed state and memory ([`solve_slip`] solves and checks it) and leaves the driver as it
+//! was; [`DriverState::commit`] then stores it (trial, then commit). A failure stops the run
+//! with the step, t, Q and regime; the steps already solved are kept by the caller (observer).
+//!
+//! # The state as data
+//! Everything a step needs from the past is [`HistoryState`]: the spectral driver's
+//! [`DriverState`] (committed state, memory, phase, displacement datum, and what only makes
+//! steps faster: the recall traces, the warm start) and the general solver's run while it
+//! holds the steps. It is written by serde and read back to the bit; a run passes it to its
+//! observer at every turning point of the load ([`turning_points`],
+//! [`Observer::on_checkpoint`]), and a run continued from a state read back takes the same
+//! steps as the run that wrote it (test
+//! `a_run_continued_from_a_checkpoint_read_back_takes_the_same_steps_to_the_bit`).
 //!
 //! A step's increments — Δδ at the anchor, the frictional dissipation and the works of P and
 //! of the electric load ([`StepIncrements`], [`step_dissipation`]) — need only the step's two
@@ -32,8 +43,10 @@
 //! structure, ends within two elements); the spectral solver then commits that state with its
 //! own increments. Under [`SolverChoice::Auto`] the general solver also takes the first step
 //! of every phase, where thin end zones that slip the old way form in a coupled contact, and
-//! the spectral solver's step is handed over when the two disagree. Each record says which
-//! solver took the step ([`SolverKind`]) and the zone structure ([`ZoneCount`]).
+//! the spectral solver's step is handed over when the two disagree. The spectral solver tries
+//! to take the state back after 1, 2, 4, … general steps of the phase (a try costs about as
+//! much as a spectral step that fails, many general steps). Each record says which solver took
+//! the step ([`SolverKind`]) and the zone structure ([`ZoneCount`]).
 //!
 //! # Warm start
 //! Inside a phase the geometry of the step (stick ends, contact half-width and centre) is

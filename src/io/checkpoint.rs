@@ -14,7 +14,7 @@
 //!   previous step) and the handovers so far;
 //! - `state`: everything the next step needs ([`HistoryState`]).
 //!
-//! Values shared by several states are written once ([`crate::shared`]). A run resumed from a
+//! Values shared by several states are written once (`crate::shared`). A run resumed from a
 //! checkpoint takes the same steps, to the bit, as the run that wrote it would have taken, so
 //! its output folder is byte for byte the uninterrupted run's. The checkpoint is removed when
 //! the output folder is committed; a failed run's last state is in its `failure.json`.
