@@ -289,6 +289,52 @@ pub struct SlipStep {
     pub repeated: bool,
 }
 
+/// Which way the two slip zones slip: the states the spectral solver moves between, tried in
+/// the order of its attempt plan. `q = ηp·s` in a slip zone with sign `s`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SlipPattern {
+    /// Both zones with a load that increases: s = +1 at both edges.
+    Forward,
+    /// Both zones with a load that decreases: s = −1 at both edges.
+    Reverse,
+    /// Inward friction at both edges: s = +1 on the left, −1 on the right (a reversal in a
+    /// coupled contact, one edge still slipping the old way).
+    Inward,
+    /// Outward friction at both edges: s = −1 on the left, +1 on the right.
+    Outward,
+}
+
+impl SlipPattern {
+    /// Both zones slipping with a load change of sign `sign`.
+    pub fn with_load(sign: f64) -> Self {
+        if sign > 0.0 {
+            Self::Forward
+        } else {
+            Self::Reverse
+        }
+    }
+
+    /// The pattern of the slip signs `(left, right)` (each ±1).
+    pub fn of_signs((left, right): (f64, f64)) -> Self {
+        match (left > 0.0, right > 0.0) {
+            (true, true) => Self::Forward,
+            (false, false) => Self::Reverse,
+            (true, false) => Self::Inward,
+            (false, true) => Self::Outward,
+        }
+    }
+
+    /// The slip signs `(left, right)`.
+    pub fn signs(self) -> (f64, f64) {
+        match self {
+            Self::Forward => (1.0, 1.0),
+            Self::Reverse => (-1.0, -1.0),
+            Self::Inward => (1.0, -1.0),
+            Self::Outward => (-1.0, 1.0),
+        }
+    }
+}
+
 /// What a step passes to the next one of the same phase: its slip signs and Jacobian.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, serde::Deserialize)]
 pub struct WarmStart {

@@ -20,7 +20,9 @@ use super::residual::{
     inner_tolerance,
 };
 use super::reuse::{COARSE_MAPS, LentMaps, Reused};
-use super::{PhaseStart, Recalled, SlipOptions, SlipStep, StepAdmissibility, WarmStart};
+use super::{
+    PhaseStart, Recalled, SlipOptions, SlipPattern, SlipStep, StepAdmissibility, WarmStart,
+};
 
 /// Largest first residual with which a recalled step is continued ([`Recalled`]): where the
 /// step's problem is the recalled one's, the first residual is the recalled state's own, below
@@ -76,7 +78,10 @@ pub fn solve_slip(
         .filter(|_| warm.is_none() && options.mixed_start_guesses)
         .map(|last| {
             let from = contact.unwrap_or((start.half_width, start.centre));
-            (last.signs, last.guess(sign, guess, from))
+            (
+                SlipPattern::of_signs(last.signs),
+                last.guess(sign, guess, from),
+            )
         });
     if let Some(entry) = preferred {
         let at = plan
@@ -110,7 +115,8 @@ pub fn solve_slip(
     // Every attempt is made with the fast quasi-Newton iteration first; the jumps above are
     // where it can miss a root that Newton's method finds, so Newton's method is the fallback.
     'attempts: for newton in [false, true] {
-        for &(signs, guess) in &plan {
+        for &(pattern, guess) in &plan {
+            let signs = pattern.signs();
             if attempts.stalled.is_some() {
                 break 'attempts;
             }
@@ -122,7 +128,7 @@ pub fn solve_slip(
                 None => Method::Broyden(None),
             };
             // Within a phase the prediction continues the warm start's slip signs only.
-            let first = guess == guesses_in[0] || preferred == Some((signs, guess));
+            let first = guess == guesses_in[0] || preferred == Some((pattern, guess));
             let contact = contact.filter(|_| first && warm.is_none_or(|w| w.signs == signs));
             let attempt = (guess, contact);
             if let Some(step) =
@@ -194,33 +200,37 @@ fn distinct_guesses(guesses_in: &[Zone], remembered: &[Zone], a: f64) -> (Vec<Zo
     (warm_guesses, jump_guesses)
 }
 
-/// The attempts of a step in phase `sign`, as `(slip signs, stick-zone guess)`, in order;
+/// The attempts of a step in phase `sign`, as `(slip pattern, stick-zone guess)`, in order;
 /// `warm_start` when the step is not the first of its phase.
 ///
-/// Mixed states: inward friction at both edges (q > 0 on the left, q < 0 on the right)
-/// before outward; both patterns are their own mirror images, so the order does not
-/// depend on the direction of loading. At the first step of a phase (no warm start) the
-/// mixed states are what the reversal needs, and the continuations are tried in every
-/// state before the jumps to remembered boundaries; later in a phase the jumps of the
-/// standard state come first.
+/// Mixed states: inward friction at both edges ([`SlipPattern::Inward`]) before outward;
+/// both patterns are their own mirror images, so the order does not depend on the direction
+/// of loading. At the first step of a phase (no warm start) the mixed states are what the
+/// reversal needs, and the continuations are tried in every state before the jumps to
+/// remembered boundaries; later in a phase the jumps of the standard state come first (test
+/// `the_attempt_plan_is_pinned`).
 fn attempt_plan(
     sign: f64,
     warm_start: bool,
     warm_guesses: &[Zone],
     jump_guesses: &[Zone],
-) -> Vec<((f64, f64), Zone)> {
-    let patterns = [(sign, sign), (1.0, -1.0), (-1.0, 1.0)];
+) -> Vec<(SlipPattern, Zone)> {
+    let patterns = [
+        SlipPattern::with_load(sign),
+        SlipPattern::Inward,
+        SlipPattern::Outward,
+    ];
     let mut plan = Vec::new();
     if warm_start {
-        for signs in patterns {
+        for pattern in patterns {
             for set in [warm_guesses, jump_guesses] {
-                plan.extend(set.iter().map(|&g| (signs, g)));
+                plan.extend(set.iter().map(|&g| (pattern, g)));
             }
         }
     } else {
         for set in [warm_guesses, jump_guesses] {
-            for signs in patterns {
-                plan.extend(set.iter().map(|&g| (signs, g)));
+            for pattern in patterns {
+                plan.extend(set.iter().map(|&g| (pattern, g)));
             }
         }
     }
@@ -900,6 +910,42 @@ mod tests {
                     previous = Some(fine);
                 }
             }
+        }
+    }
+
+    /// The order in which a step's attempts are made: at a phase start every pattern with
+    /// the continued guesses, then every pattern with the jumps; within a phase the
+    /// standard pattern with both first.
+    #[test]
+    fn the_attempt_plan_is_pinned() {
+        use SlipPattern::{Forward, Inward, Outward, Reverse};
+        let (warm, jump) = ((1.0, 2.0), (3.0, 4.0));
+        let start = attempt_plan(1.0, false, &[warm], &[jump]);
+        assert_eq!(
+            start,
+            [
+                (Forward, warm),
+                (Inward, warm),
+                (Outward, warm),
+                (Forward, jump),
+                (Inward, jump),
+                (Outward, jump),
+            ]
+        );
+        let within = attempt_plan(-1.0, true, &[warm], &[jump]);
+        assert_eq!(
+            within,
+            [
+                (Reverse, warm),
+                (Reverse, jump),
+                (Inward, warm),
+                (Inward, jump),
+                (Outward, warm),
+                (Outward, jump),
+            ]
+        );
+        for pattern in [Forward, Reverse, Inward, Outward] {
+            assert_eq!(SlipPattern::of_signs(pattern.signs()), pattern);
         }
     }
 }
