@@ -160,7 +160,12 @@ pub fn continue_run(
         };
         let record = match step {
             Ok(record) => record,
-            Err(failure) => return Some(failure),
+            Err(failure) => {
+                // The run holds the state after the last accepted step (a failed step
+                // leaves it as it was).
+                state.general = Some(run);
+                return Some(failure);
+            }
         };
         let mut record = record;
         let back = match options.solver {
@@ -169,7 +174,7 @@ pub fn continue_run(
                 disc,
                 driver,
                 &mut run,
-                (points[next], &record),
+                (points[next], &record, turning[next]),
                 options.slip,
             ),
             _ => None,
@@ -212,12 +217,16 @@ fn current_load(state: &HistoryState) -> f64 {
 /// solver's value and the general steps' discretisation error in δ does not accumulate over
 /// cycles. Returns those increments from the state of the handover (δ, and the works of P and
 /// of the electric load, which are differences of state functions too).
+///
+/// Tried after 1, 2, 4, … general steps of the phase ([`GeneralRun::resume_due`]), and at
+/// the step that ends the phase (`last_of_phase`, a turning point of the load): after it the
+/// spectral solver's memory no longer holds.
 fn resumes(
     model: &ContactModel,
     disc: &Discretisation,
     driver: &mut DriverState,
     run: &mut GeneralRun,
-    (point, last): (LoadPoint, &StepRecord),
+    (point, last, last_of_phase): (LoadPoint, &StepRecord, bool),
     options: SlipOptions,
 ) -> Option<StepIncrements> {
     let same_phase =
@@ -225,22 +234,23 @@ fn resumes(
     if !same_phase || last.regime.slip_sign().is_none() {
         return None;
     }
-    if !run.resume_due() {
+    if !run.resume_due() && !last_of_phase {
         return None;
     }
-    let trial = match try_step(model, disc, driver, point, options) {
-        Ok(Tried::Slip(trial)) if agrees(run, last, &trial.record(driver)) => trial,
+    match try_step(model, disc, driver, point, options) {
+        Ok(Tried::Slip(trial)) if agrees(run, last, &trial.record(driver)) => {
+            let solved = driver.commit(*trial);
+            let increments = solved.known_increments().unwrap_or_else(|| {
+                StepIncrements::compute(model, &solved.increment_inputs(driver))
+            });
+            finish_step(driver, solved, increments, &mut NoObserver);
+            Some(increments)
+        }
         _ => {
             run.resume_failed();
-            return None;
+            None
         }
-    };
-    let solved = driver.commit(*trial);
-    let increments = solved
-        .known_increments()
-        .unwrap_or_else(|| StepIncrements::compute(model, &solved.increment_inputs(driver)));
-    finish_step(driver, solved, increments, &mut NoObserver);
-    Some(increments)
+    }
 }
 
 /// Where the spectral solver stopped: the index of the step it did not take, why, and the
