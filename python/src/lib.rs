@@ -45,9 +45,10 @@ fn to_py(error: Error) -> PyErr {
             ScenarioError::new_err((message.clone(), vec![(at, message)]))
         }
         Error::Solve { .. } | Error::SweepFailed { .. } => SolveError::new_err(message),
-        Error::ReadScenario { .. } | Error::OutputRefused { .. } | Error::WriteOutput { .. } => {
-            OutputError::new_err(message)
-        }
+        Error::ReadScenario { .. }
+        | Error::OutputRefused { .. }
+        | Error::Resume { .. }
+        | Error::WriteOutput { .. } => OutputError::new_err(message),
     }
 }
 
