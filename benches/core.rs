@@ -153,10 +153,8 @@ fn steps(c: &mut Criterion) {
     );
     // The same without the coarse grid's Jacobian (`SlipOptions::coarse_jacobian`), on the
     // grids that have one: the comparison under the same host load.
-    let carried = SlipOptions {
-        coarse_jacobian: false,
-        ..options
-    };
+    let mut carried = options;
+    carried.accelerations.coarse_jacobian = false;
     let sizes = [128, 256, 512];
     bench_state(
         c,

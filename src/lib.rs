@@ -65,6 +65,9 @@
 //! - [`contact`]: the contact model and state; [`contact::frictionless`] (Hertz, Zhou & Lee),
 //!   [`contact::normal`] (Spence's self-similar partial slip), [`contact::pressure`] (shared
 //!   pressure and charge sub-problems).
+//! - `cache`: the crate's only statics (tables keyed by size, each thread's scratch
+//!   buffers); the speed-ups that carry information from step to step are switched by
+//!   [`contact::tangential::Accelerations`].
 //! - [`analytical`]: closed-form oracles.
 //! - [`analysis`]: the cycles of a history, the energy per cycle and the verdict.
 //! - [`scenario`], [`io`], [`cli`], [`error`]: input, solving and writing a run or a sweep, arguments,
@@ -74,6 +77,7 @@
 
 pub mod analysis;
 pub mod analytical;
+mod cache;
 pub mod cli;
 pub mod contact;
 pub mod error;

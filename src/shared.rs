@@ -9,20 +9,16 @@
 //! (`"id"` absent), as serde's own `Arc` support does. Fields opt in with
 //! `#[serde(with = "crate::shared")]` (or `crate::shared::option` for an `Option<Arc<T>>`).
 
-use std::any::{Any, TypeId};
-use std::cell::RefCell;
+use std::any::TypeId;
 use std::collections::HashMap;
 use std::sync::Arc;
 
 use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-thread_local! {
-    /// While writing: the id of each `Arc` met, by type and address.
-    static WRITTEN: RefCell<Option<HashMap<(TypeId, usize), u64>>> = const { RefCell::new(None) };
-    /// While reading: each `Arc` read, by id.
-    static READ: RefCell<Option<HashMap<u64, Box<dyn Any>>>> = const { RefCell::new(None) };
-}
+// While writing: the id of each `Arc` met, by type and address; while reading: each `Arc`
+// read, by id (`crate::cache`).
+use crate::cache::{SERDE_READ as READ, SERDE_WRITTEN as WRITTEN};
 
 /// Run `write` (a serialisation) with shared `Arc`s written once; inside another
 /// `write_shared`, as part of the outer one (its values are shared with the outer's).

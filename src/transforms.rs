@@ -20,22 +20,18 @@
 //! (133 kB at M = 128) through the cache at every pass of the tangential solver's inner
 //! iteration.
 
-use std::cell::RefCell;
 use std::sync::Arc;
 
 use realfft::num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 
-/// Buffers of one thread's transforms, grown to the largest size used.
+/// Buffers of one thread's transforms, grown to the largest size used
+/// ([`crate::cache::with_transform_work`]).
 #[derive(Default)]
-struct Work {
+pub(crate) struct Work {
     real: Vec<f64>,
     spectrum: Vec<Complex<f64>>,
     scratch: Vec<Complex<f64>>,
-}
-
-thread_local! {
-    static WORK: RefCell<Work> = RefCell::default();
 }
 
 /// Run `f` with this thread's buffers: `real` of length `real_len`, `spectrum` of
@@ -45,7 +41,7 @@ fn with_work<R>(
     scratch_len: usize,
     f: impl FnOnce(&mut [f64], &mut [Complex<f64>], &mut [Complex<f64>]) -> R,
 ) -> R {
-    WORK.with_borrow_mut(|w| {
+    crate::cache::with_transform_work(|w| {
         let zero = Complex::new(0.0, 0.0);
         w.real.resize(real_len.max(w.real.len()), 0.0);
         w.spectrum

@@ -65,9 +65,9 @@ pub mod tangential;
 
 mod inherited;
 mod kinks;
-mod rules;
+pub(crate) mod rules;
 mod state;
-mod stick_zone;
+pub(crate) mod stick_zone;
 mod surface;
 
 use serde::Serialize;
@@ -87,7 +87,7 @@ pub use rules::{
     slip_check_rule_nodes, slip_zone_rule_nodes, slip_zone_smooth_nodes, step_breakpoints,
 };
 pub use state::{ContactState, Traction};
-pub use stick_zone::StickZone;
+pub use stick_zone::{StickZone, ZoneTables};
 pub use surface::{GapReport, SurfacePoint};
 
 /// How the punch is connected electrically (piezoelectric half-plane only).

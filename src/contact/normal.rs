@@ -43,7 +43,7 @@ use crate::quadrature::{BoundedSeries, UnboundedSeries};
 use super::pressure::{
     Discretisation, electric_resultants, solve_potential_charge, solve_pressure,
 };
-use super::{ContactModel, ContactState, StickZone, Traction};
+use super::{ContactModel, ContactState, StickZone, Traction, ZoneTables};
 
 /// Result of the normal-loading solve.
 #[derive(Debug, Clone, Serialize)]
@@ -73,6 +73,11 @@ pub struct NormalOptions {
     /// (relative to `|C| b²`). Every converged state measured so far (Spence, aluminium, PZT-4
     /// at η = 0.1–0.8, Γ = 0–9e−7, M = 16–256) has both ≤ 0; 1e−3 leaves room for coarse M.
     pub admissibility: f64,
+    /// Which tables the final stick zone may build; it is tabulated when it may
+    /// ([`StickZone::tabulate`]: every tangential phase that begins from it evaluates it at
+    /// every residual evaluation). All in [`Default`]; none on the reference path of
+    /// [`crate::contact::tangential::Accelerations`].
+    pub zone_tables: ZoneTables,
 }
 
 impl Default for NormalOptions {
@@ -81,6 +86,7 @@ impl Default for NormalOptions {
             tolerance: 1e-11,
             max_iterations: 200,
             admissibility: 1e-3,
+            zone_tables: ZoneTables::default(),
         }
     }
 }
@@ -258,7 +264,10 @@ fn solve_normal_directed(
         if change < options.tolerance {
             // Final stick solve with the converged pressure.
             let (b_fin, slope_fin, correction, kink) = find_stick_zone(model, disc, &state, b)?;
-            state.traction.stick = Some(StickZone::new(-b_fin, b_fin, correction, kink));
+            state.traction.stick = Some(StickZone {
+                tables: options.zone_tables,
+                ..StickZone::new(-b_fin, b_fin, correction, kink)
+            });
             // The state is evaluated many times from here on (checks, fields, memory).
             state.tabulate_shape();
             if let Some(zone) = state.traction.stick.as_ref() {

@@ -227,13 +227,10 @@ pub fn graded_cumulative(
     table
 }
 
-/// The graded rule with `nodes` points and its cumulative matrix, built once per size.
+/// The graded rule with `nodes` points and its cumulative matrix, built once per size
+/// ([`crate::cache`]).
 pub(super) fn graded_rule_with(nodes: usize) -> &'static GradedRule {
-    static RULES: SizeTables<GradedRule> = std::sync::Mutex::new(Vec::new());
-    thread_local! {
-        static KNOWN: KnownSizes<GradedRule> = const { std::cell::RefCell::new(Vec::new()) };
-    }
-    built_once(&RULES, &KNOWN, nodes, GradedRule::new)
+    crate::cache::graded_rule(nodes)
 }
 
 /// Nodes of the plain rule on a smooth piece (both ends made by the balancing) of a rule that
@@ -244,47 +241,10 @@ fn smooth_piece_nodes(graded: usize) -> usize {
 }
 
 /// The plain Gauss–Legendre rule with `nodes` points and its cumulative matrix (the smooth
-/// pieces of [`graded_nodes`] and [`graded_cumulative`]), built once per size.
+/// pieces of [`graded_nodes`] and [`graded_cumulative`]), built once per size
+/// ([`crate::cache`]).
 fn plain_rule_with(nodes: usize) -> &'static GradedRule {
-    static RULES: SizeTables<GradedRule> = std::sync::Mutex::new(Vec::new());
-    thread_local! {
-        static KNOWN: KnownSizes<GradedRule> = const { std::cell::RefCell::new(Vec::new()) };
-    }
-    built_once(&RULES, &KNOWN, nodes, GradedRule::plain)
-}
-
-/// Tables of one kind built once per size for the whole run: `(size, table)`.
-pub(super) type SizeTables<T> = std::sync::Mutex<Vec<(usize, &'static T)>>;
-
-/// A thread's copy of the entries of a [`SizeTables`] it has used.
-pub(super) type KnownSizes<T> = std::cell::RefCell<Vec<(usize, &'static T)>>;
-
-/// The table of `size` from `shared`, built by `make` on first use and kept for the run. Each
-/// thread keeps the tables it has used in `known`: the two threads of a history (steps and
-/// their increments) look tables up thousands of times per run, and contended locks of the
-/// shared list cost 3 % of the default run in futex calls.
-pub(super) fn built_once<T: Sync + 'static>(
-    shared: &'static SizeTables<T>,
-    known: &'static std::thread::LocalKey<KnownSizes<T>>,
-    size: usize,
-    make: impl FnOnce(usize) -> T,
-) -> &'static T {
-    let find = |tables: &Vec<(usize, &'static T)>| {
-        tables.iter().find(|(n, _)| *n == size).map(|(_, t)| *t)
-    };
-    if let Some(table) = known.with_borrow(find) {
-        return table;
-    }
-    let mut tables = shared
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    let table = find(&tables).unwrap_or_else(|| {
-        let table: &'static T = Box::leak(Box::new(make(size)));
-        tables.push((size, table));
-        table
-    });
-    known.with_borrow_mut(|k| k.push((size, table)));
-    table
+    crate::cache::plain_rule(nodes)
 }
 
 /// Nodes per piece of the graded rule of [`graded_rule`].
@@ -307,7 +267,7 @@ pub(super) const FADE_RULE_NODES: usize = 64;
 
 /// A sine-graded Gauss–Legendre rule on [−1, 1] (`u = sin(πv/2)`, see [`graded_rule`]) with
 /// its cumulative matrix.
-pub(super) struct GradedRule {
+pub(crate) struct GradedRule {
     pub(super) nodes: Vec<f64>,
     pub(super) weights: Vec<f64>,
     /// Row k: the weights of `∫_{-1}^{u_k}` in the graded variable, row-major n × n.
@@ -315,7 +275,7 @@ pub(super) struct GradedRule {
 }
 
 impl GradedRule {
-    fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         let (v, w) = crate::quadrature::gauss_legendre(n);
         let s = crate::quadrature::gauss_legendre_cumulative(n);
         let half_pi = std::f64::consts::FRAC_PI_2;
@@ -335,7 +295,7 @@ impl GradedRule {
     }
 
     /// The plain n-point Gauss–Legendre rule with its cumulative matrix (no grading).
-    fn plain(n: usize) -> Self {
+    pub(crate) fn plain(n: usize) -> Self {
         let (nodes, weights) = crate::quadrature::gauss_legendre(n);
         Self {
             nodes,

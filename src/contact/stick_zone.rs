@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::quadrature::BoundedSeries;
 
 use super::inherited::sign_blend;
-use super::rules::{KnownSizes, SizeTables, built_once, piece_ends};
+use super::rules::piece_ends;
 use super::{
     Inherited, half_ellipse, half_ellipse_cauchy, half_ellipse_integral, kink_cauchy, kink_density,
 };
@@ -55,6 +55,37 @@ pub struct StickZone {
     /// points of the slip zones (`EXTERIOR_TABLE_POINTS`; the checks and increments of the
     /// steps it ends and begins).
     pub(super) exterior_table: TableCache<[ChainTable; 2]>,
+    /// Which of the tables above the zone may build (written only when not all).
+    #[serde(skip_serializing_if = "ZoneTables::all")]
+    pub tables: ZoneTables,
+}
+
+/// Which tables a [`StickZone`] may build: [`StickZone::tabulate`]'s piecewise tables of
+/// `H'q̃` and q̃ (`chain`), and the exterior tables of `H'q̃` beside its ends (`exterior`).
+/// Both in [`Default`]; a zone that may build neither evaluates its chain directly
+/// ([`crate::contact::tangential::Accelerations`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ZoneTables {
+    /// [`StickZone::tabulate`]'s tables.
+    pub chain: bool,
+    /// The exterior tables.
+    pub exterior: bool,
+}
+
+impl Default for ZoneTables {
+    fn default() -> Self {
+        Self {
+            chain: true,
+            exterior: true,
+        }
+    }
+}
+
+impl ZoneTables {
+    /// Whether every table is allowed.
+    fn all(&self) -> bool {
+        self.chain && self.exterior
+    }
 }
 
 /// A [`StickZone`] as written: its data, and which of its tables were built (the points per
@@ -74,6 +105,8 @@ struct StickZoneData {
     extras: Vec<(f64, f64, f64)>,
     cauchy_table: Option<usize>,
     exterior_table: bool,
+    #[serde(default)]
+    tables: ZoneTables,
 }
 
 impl From<StickZoneData> for StickZone {
@@ -83,6 +116,7 @@ impl From<StickZoneData> for StickZone {
             end_roots: d.end_roots,
             end_signs: d.end_signs,
             extras: d.extras,
+            tables: d.tables,
             ..Self::new(d.lo, d.hi, d.correction, d.kink)
         };
         if let Some(nodes) = d.cauchy_table {
@@ -228,27 +262,25 @@ impl ChainTable {
 }
 
 /// The Chebyshev points `v_k = cos θ_k`, `θ_k = (2k+1)π/(2N)`, of a [`ChainTable`]'s pieces
-/// and the fast transform of its cosine sums, built once per N: computing the N² cosines for
-/// every table would cost far more than the transform that uses them.
-struct ChebyshevPoints {
+/// and the fast transform of its cosine sums, built once per N ([`crate::cache`]): computing
+/// the N² cosines for every table would cost far more than the transform that uses them.
+pub(crate) struct ChebyshevPoints {
     v: Vec<f64>,
     transforms: crate::transforms::HalfAngleTransforms,
 }
 
 impl ChebyshevPoints {
     fn of(nodes: usize) -> &'static Self {
-        static POINTS: SizeTables<ChebyshevPoints> = std::sync::Mutex::new(Vec::new());
-        thread_local! {
-            static KNOWN: KnownSizes<ChebyshevPoints> =
-                const { std::cell::RefCell::new(Vec::new()) };
+        crate::cache::chebyshev_points(nodes)
+    }
+
+    /// The points and transform for N = `n`.
+    pub(crate) fn new(n: usize) -> Self {
+        let theta = |k: usize| (2 * k + 1) as f64 * std::f64::consts::PI / (2 * n) as f64;
+        Self {
+            v: (0..n).map(|k| theta(k).cos()).collect(),
+            transforms: crate::transforms::HalfAngleTransforms::new(n),
         }
-        built_once(&POINTS, &KNOWN, nodes, |n| {
-            let theta = |k: usize| (2 * k + 1) as f64 * std::f64::consts::PI / (2 * n) as f64;
-            Self {
-                v: (0..n).map(|k| theta(k).cos()).collect(),
-                transforms: crate::transforms::HalfAngleTransforms::new(n),
-            }
-        })
     }
 }
 
@@ -359,6 +391,7 @@ impl StickZone {
             cauchy_table: TableCache::default(),
             value_table: TableCache::default(),
             exterior_table: TableCache::default(),
+            tables: ZoneTables::default(),
         }
     }
 
@@ -372,8 +405,11 @@ impl StickZone {
 
     /// Tabulate `H'q̃` and q̃ (see `ChainTable`) for a zone that will be evaluated many times
     /// (one that a phase inherits from), with `nodes` Chebyshev points per piece. No-op if
-    /// already done.
+    /// already done, or if the zone may not build them ([`ZoneTables::chain`]).
     pub fn tabulate(&self, nodes: usize) {
+        if !self.tables.chain {
+            return;
+        }
         let width = self.hi - self.lo;
         let slack = 1e-12 * width;
         let mut inner = self.chain_points();
@@ -592,6 +628,9 @@ impl StickZone {
     fn exterior_tables(&self, xs: &[f64]) -> Option<&[ChainTable; 2]> {
         if let Some(tables) = self.exterior_table.0.get() {
             return Some(tables);
+        }
+        if !self.tables.exterior {
+            return None;
         }
         let width = self.hi - self.lo;
         let outer =

@@ -192,14 +192,11 @@ impl ColumnMatrix {
     }
 
     /// `f` of the padded sums `A x_k`, one after the other a stride apart, in this thread's
-    /// buffer: the products run at every pass of the tangential solver's inner iteration,
+    /// buffer ([`crate::cache::with_column_sums`]): the products run at every pass of the tangential solver's inner iteration,
     /// which allocates nothing per pass.
     fn with_sums<const K: usize>(&self, x: [&[f64]; K], f: impl FnOnce(&[f64])) {
         debug_assert!(x.iter().all(|x| x.len() == self.cols));
-        thread_local! {
-            static SUMS: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
-        }
-        SUMS.with_borrow_mut(|sums| {
+        crate::cache::with_column_sums(|sums| {
             sums.clear();
             sums.resize(K * self.stride, 0.0);
             pulp::Arch::new().dispatch(SumColumns {

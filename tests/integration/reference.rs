@@ -1541,7 +1541,8 @@ fn pipelined_history_matches_sequential_steps() {
 #[test]
 fn recalled_cycles_repeat_the_solved_ones() {
     let b = baseline(32);
-    let (recalled, solved) = with_and_without(&b, default_points(&b), |o, on| o.recall = on);
+    let (recalled, solved) =
+        with_and_without(&b, default_points(&b), |o, on| o.accelerations.recall = on);
     // Fewer than seven tenths.
     assert_fewer_evaluations(&recalled, &solved, 14);
     assert_same_states(&recalled, &solved);
@@ -1572,8 +1573,9 @@ fn recalled_cycles_repeat_the_solved_ones() {
 fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
     let b = baseline(96);
     assert!(b.disc.coarse().is_some());
-    let (coarse, carried) =
-        with_and_without(&b, default_points(&b), |o, on| o.coarse_jacobian = on);
+    let (coarse, carried) = with_and_without(&b, default_points(&b), |o, on| {
+        o.accelerations.coarse_jacobian = on
+    });
     assert_fewer_evaluations(&coarse, &carried, 19);
     // The second step of a phase that began mixed changes back to the standard signs, for
     // which the first step has no Jacobian: the coarse grid's replaces a fine
@@ -1607,8 +1609,9 @@ fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
 fn projected_updates_reach_the_same_states_in_fewer_evaluations() {
     let b = baseline(32);
     assert!(b.disc.coarse().is_none());
-    let (projected, broyden) =
-        with_and_without(&b, default_points(&b), |o, on| o.projected_updates = on);
+    let (projected, broyden) = with_and_without(&b, default_points(&b), |o, on| {
+        o.accelerations.projected_updates = on
+    });
     assert_fewer_evaluations(&projected, &broyden, 18);
     assert_same_states(&projected, &broyden);
 }
@@ -1625,8 +1628,9 @@ fn projected_updates_reach_the_same_states_in_fewer_evaluations() {
 #[test]
 fn later_reversals_start_from_the_last_mixed_pattern() {
     let b = baseline(32);
-    let (hinted, plain) =
-        with_and_without(&b, default_points(&b), |o, on| o.mixed_start_guesses = on);
+    let (hinted, plain) = with_and_without(&b, default_points(&b), |o, on| {
+        o.accelerations.mixed_start_guesses = on
+    });
     for phase in 2..=4 {
         let (h, p) = (phase_step(&hinted, phase, 0), phase_step(&plain, phase, 0));
         println!(
@@ -1666,7 +1670,8 @@ fn phase_starts_keep_the_standard_pattern_where_it_passes() {
         .enumerate()
         .map(|(k, f)| (k as f64, f * b.lim))
         .collect::<Vec<_>>();
-    let (hinted, plain) = with_and_without(&b, points, |o, on| o.mixed_start_guesses = on);
+    let (hinted, plain) =
+        with_and_without(&b, points, |o, on| o.accelerations.mixed_start_guesses = on);
     // The first steps of the phases after the first loading's.
     let phases = hinted.last().expect("steps").phase;
     let starts: Vec<_> = (2..=phases)

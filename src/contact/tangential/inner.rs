@@ -39,7 +39,7 @@ impl StickSums {
 /// [`Discretisation::bounded_at_collocation`]:
 ///     crate::contact::pressure::Discretisation::bounded_at_collocation
 #[derive(Default)]
-pub(super) struct InnerMaps {
+pub(crate) struct InnerMaps {
     /// `T_n(τ_i)`, n = 0 … M + 1, at the stick points (τ in the contact's coordinate).
     stick_t: ColumnMatrix,
     /// `1/√(1 − τ_i²)` at the stick points.

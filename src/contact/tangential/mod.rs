@@ -147,6 +147,7 @@
 //! (measured: Figure-3 history at M = 96, or η = 0.2, 0.4: Δs changed sign within 7e−5 a of the
 //! receding end, with the frictional work there below 1e−2 of the largest).
 
+mod accelerations;
 mod checks;
 mod inner;
 mod kinks;
@@ -155,7 +156,9 @@ mod residual;
 mod reuse;
 mod search;
 
+pub use accelerations::Accelerations;
 pub use checks::assess_step;
+pub(crate) use inner::InnerMaps;
 pub use search::solve_slip;
 
 use residual::Geometry;
@@ -209,30 +212,26 @@ pub struct SlipOptions {
     /// by 1e−3 a in one stick end, the size of the discretisation error of the stick ends at
     /// M = 64 (convergence study in `docs/performance.md`), and the next step is unaffected.
     pub stall_tolerance: f64,
-    /// Start a step from the same step of the last phase in the same direction that began
-    /// from the same turning state, when there is one ([`Recalled`]; the history driver keeps
-    /// them). In a steady cycle that state solves the step again, in one evaluation.
-    pub recall: bool,
-    /// Within a phase, start each attempt from the finite-difference Jacobian of the coarse
-    /// companion grid ([`Discretisation::coarse`]) at its first iterate instead of the one
-    /// carried from the previous step, or, for slip signs other than the previous step's,
-    /// instead of a fine finite-difference one (where the grid has a coarse companion). The
-    /// states are the same to the tolerance; the steps take fewer residual evaluations (the
-    /// second step of a phase that began mixed, M = 128: 8 instead of 11).
-    ///
-    /// [`Discretisation::coarse`]: crate::contact::pressure::Discretisation::coarse
-    pub coarse_jacobian: bool,
-    /// At a phase start, try the mixed slip pattern that began the last phase that began mixed
-    /// (after the standard pattern's attempts, before the other mixed ones), from its stick end
-    /// next to the edge that slipped against the phase ([`PhaseStart`]; the history driver
-    /// keeps it). The states are the same to the tolerance; the later reversals of a coupled
-    /// contact start their mixed attempt near their own state.
-    pub mixed_start_guesses: bool,
-    /// Within a phase, update the Jacobian by the projected secant update
-    /// (`SecantDirections`) instead of Broyden's: each update keeps the Jacobian's action on
-    /// the attempt's earlier step directions. The states are the same to the tolerance; the
-    /// steps take fewer residual evaluations.
-    pub projected_updates: bool,
+    /// The speed-ups that carry information from one evaluation or step to the next
+    /// ([`Accelerations`]; all on by default, [`Accelerations::none`] for the reference path).
+    /// Their fields also read through the options (`options.recall`), as the history driver
+    /// reads `recall`.
+    pub accelerations: Accelerations,
+}
+
+/// `options.recall` and the like: the switches of [`SlipOptions::accelerations`].
+impl std::ops::Deref for SlipOptions {
+    type Target = Accelerations;
+
+    fn deref(&self) -> &Accelerations {
+        &self.accelerations
+    }
+}
+
+impl std::ops::DerefMut for SlipOptions {
+    fn deref_mut(&mut self) -> &mut Accelerations {
+        &mut self.accelerations
+    }
 }
 
 impl Default for SlipOptions {
@@ -243,10 +242,7 @@ impl Default for SlipOptions {
             max_evaluations: 60,
             admissibility: 1e-3,
             stall_tolerance: 1e-4,
-            recall: true,
-            coarse_jacobian: true,
-            mixed_start_guesses: true,
-            projected_updates: true,
+            accelerations: Accelerations::default(),
         }
     }
 }
@@ -487,6 +483,7 @@ mod tests {
             scratch: maps,
             last_link,
             reused,
+            accelerations: Accelerations::default(),
         }
     }
 

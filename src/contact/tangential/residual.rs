@@ -18,6 +18,7 @@ use crate::contact::{
 use crate::error::SolveFailure;
 use crate::quadrature::{BoundedSeries, dot};
 
+use super::Accelerations;
 use super::inner::{InnerMaps, StickSums};
 use super::kinks::{EndProbes, KinkMaps, KinkPoints, pressure_root, resolved};
 use super::linalg::Anderson;
@@ -70,6 +71,8 @@ pub(super) struct StepProblem<'a> {
     /// points or through the sample points alone ([`Reused`]; one for all the attempts of a
     /// step, on both grids).
     pub(super) reused: &'a RefCell<Reused>,
+    /// The speed-ups in use (`fade_table_reuse`, `reused_parts`, the accepted zones' tables).
+    pub(super) accelerations: Accelerations,
 }
 
 impl StepProblem<'_> {
@@ -109,8 +112,10 @@ impl StepProblem<'_> {
             .map(|link| {
                 let last = self.last_link.borrow();
                 match (Arc::try_unwrap(link), last.as_deref()) {
-                    (Ok(link), Some(built)) => Arc::new(link.reusing_table_of(built)),
-                    (Ok(link), None) => Arc::new(link),
+                    (Ok(link), Some(built)) if self.accelerations.fade_table_reuse => {
+                        Arc::new(link.reusing_table_of(built))
+                    }
+                    (Ok(link), _) => Arc::new(link),
                     (Err(shared), _) => shared,
                 }
             })
@@ -233,6 +238,7 @@ impl StepProblem<'_> {
         let (kappa, ystar, eta) = (k.kappa, k.ystar, k.eta);
         let new_zone = StickZone {
             end_signs: [self.signs.0, self.signs.1],
+            tables: self.accelerations.zone_tables(),
             ..StickZone::new(g.lo, g.hi, BoundedSeries::default(), 0.0)
         };
         let negligible = 1e-14 * eta * guess.pressure_at(guess.centre).abs();
@@ -297,16 +303,20 @@ impl StepProblem<'_> {
     /// bit, so the result does not change.
     fn stick_parts(&self, points: &Points, closed: &StickZone) -> Arc<StickParts> {
         let m = self.disc.nodes();
+        let make = || {
+            let (mut chain, mut remembered) = (Vec::with_capacity(m), Vec::with_capacity(m));
+            closed.correction_cauchys_into(&points.stick, &mut chain);
+            self.memory
+                .strains_into(self.model, &points.stick, &mut remembered);
+            (chain, remembered)
+        };
+        if !self.accelerations.reused_parts {
+            return Arc::new(make());
+        }
         Reused::get_or_make(
             &mut self.reused.borrow_mut().stick,
             PartsKey::new(m, (points.mid, points.half), closed, [0.0; 2]),
-            || {
-                let (mut chain, mut remembered) = (Vec::with_capacity(m), Vec::with_capacity(m));
-                closed.correction_cauchys_into(&points.stick, &mut chain);
-                self.memory
-                    .strains_into(self.model, &points.stick, &mut remembered);
-                (chain, remembered)
-            },
+            make,
         )
     }
 
@@ -350,18 +360,22 @@ impl StepProblem<'_> {
                 .map(|(&x, inh)| (state.slip_shape(x), inh))
                 .collect()
         };
+        let make = || {
+            let charge = if conducting {
+                sampled(&points.charge)
+            } else {
+                Vec::new()
+            };
+            (sampled(&points.pressure), charge)
+        };
+        if !self.accelerations.reused_parts {
+            return Arc::new(make());
+        }
         let ends = if mixed { [g.lo, g.hi] } else { [0.0; 2] };
         Reused::get_or_make(
             &mut self.reused.borrow_mut().samples,
             PartsKey::new(m, (g.c, g.a), closed, ends),
-            || {
-                let charge = if conducting {
-                    sampled(&points.charge)
-                } else {
-                    Vec::new()
-                };
-                (sampled(&points.pressure), charge)
-            },
+            make,
         )
     }
 

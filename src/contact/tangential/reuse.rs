@@ -1,7 +1,11 @@
 //! What one evaluation or step keeps for the next: the parts of recent evaluations that
 //! depend on only two of the four unknowns (`Reused`, shared by the attempts of one step), and
 //! each thread's inner-iteration matrices, lent from step to step (`LentMaps`). Neither changes
-//! a result: every output stays byte-identical without them.
+//! a result: every output stays byte-identical without them
+//! ([`Accelerations::reused_parts`], [`Accelerations::lent_maps`]).
+//!
+//! [`Accelerations::reused_parts`]: super::Accelerations::reused_parts
+//! [`Accelerations::lent_maps`]: super::Accelerations::lent_maps
 
 use std::cell::RefCell;
 use std::sync::Arc;
@@ -105,36 +109,34 @@ impl Reused {
     }
 }
 
-thread_local! {
-    /// The [`InnerMaps`] of this thread's last step, whose matrices the next step refills
-    /// (every evaluation writes all of them). Allocated afresh at every step, they were
-    /// mapped and zeroed page by page: about half of a recalled step at M = 512, whose
-    /// matrices hold 10 MB.
-    static INNER_MAPS: RefCell<InnerMaps> = RefCell::default();
-    /// The same for the coarse grid's evaluations ([`coarse_jacobian`]).
-    pub(super) static COARSE_MAPS: RefCell<InnerMaps> = RefCell::default();
-}
-
-/// This thread's [`InnerMaps`] of one grid, lent to one step and given back when the step
-/// ends.
-pub(super) struct LentMaps(
-    pub(super) RefCell<InnerMaps>,
-    &'static std::thread::LocalKey<RefCell<InnerMaps>>,
-);
+/// This thread's [`InnerMaps`] of one grid (kept in [`crate::cache`] between steps), lent to
+/// one step and given back when the step ends; or, without
+/// [`Accelerations::lent_maps`](super::Accelerations::lent_maps), fresh ones for the step.
+/// Allocated afresh at every step the matrices are mapped and zeroed page by page: about half
+/// of a recalled step at M = 512, whose matrices hold 10 MB. Every evaluation writes all of
+/// them, so what they held before changes nothing.
+pub(super) struct LentMaps(pub(super) RefCell<InnerMaps>, Option<bool>);
 
 impl LentMaps {
-    pub(super) fn lend() -> Self {
-        Self::lend_from(&INNER_MAPS)
-    }
-
-    pub(super) fn lend_from(home: &'static std::thread::LocalKey<RefCell<InnerMaps>>) -> Self {
-        Self(RefCell::new(home.take()), home)
+    /// The maps of the fine grid (`coarse` false) or of the coarse one: this thread's when
+    /// `lend`, else fresh ones.
+    pub(super) fn lend(coarse: bool, lend: bool) -> Self {
+        if lend {
+            Self(
+                RefCell::new(crate::cache::take_inner_maps(coarse)),
+                Some(coarse),
+            )
+        } else {
+            Self(RefCell::default(), None)
+        }
     }
 }
 
 impl Drop for LentMaps {
     fn drop(&mut self) {
-        self.1.set(self.0.take());
+        if let Some(coarse) = self.1 {
+            crate::cache::give_back_inner_maps(coarse, self.0.take());
+        }
     }
 }
 
@@ -174,7 +176,7 @@ mod tests {
             .stick
             .as_ref()
             .and_then(|z| z.inherited.clone());
-        let maps = LentMaps::lend();
+        let maps = LentMaps::lend(false, true);
         let (last_link, shared) = (RefCell::new(None), RefCell::new(Reused::default()));
         let with_shared = forward_problem(
             &sc,

@@ -19,7 +19,7 @@ use super::residual::{
     Geometry, INNER_TOLERANCE, JACOBIAN_INNER_TOLERANCE, LOOSEST_INNER_TOLERANCE, StepProblem,
     inner_tolerance,
 };
-use super::reuse::{COARSE_MAPS, LentMaps, Reused};
+use super::reuse::{LentMaps, Reused};
 use super::{
     PhaseStart, Recalled, SlipOptions, SlipPattern, SlipStep, StepAdmissibility, WarmStart,
 };
@@ -91,7 +91,7 @@ pub fn solve_slip(
         plan.insert(at, entry);
     }
     let mut attempts = Attempts::default();
-    let scratch = LentMaps::lend();
+    let scratch = LentMaps::lend(false, options.lent_maps);
     let last_link = RefCell::new(None);
     let reused = RefCell::new(Reused::default());
     let problem_for = |signs: (f64, f64)| StepProblem {
@@ -105,6 +105,7 @@ pub fn solve_slip(
         scratch: &scratch.0,
         last_link: &last_link,
         reused: &reused,
+        accelerations: options.accelerations,
     };
     if let Some(step) = recalled.and_then(|r| recall(&problem_for, start, r, options)) {
         return Ok(step);
@@ -390,7 +391,7 @@ fn coarse_jacobian(
     g: &Geometry,
     guess: &ContactState,
 ) -> Option<[[f64; 4]; 4]> {
-    let maps = LentMaps::lend_from(&COARSE_MAPS);
+    let maps = LentMaps::lend(true, problem.accelerations.lent_maps);
     let coarse = StepProblem {
         disc: problem.disc.coarse()?,
         scratch: &maps.0,
@@ -857,7 +858,7 @@ mod tests {
                 solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
             let mut driver = DriverState::after_normal_loading(&normal);
             let base = normal.state.traction.stick.clone().map(Arc::new);
-            let maps = LentMaps::lend();
+            let maps = LentMaps::lend(false, true);
             // The fine Jacobian at the state the driver has reached, and the step's problem.
             let at_state = |driver: &DriverState| {
                 let state = &driver.state;

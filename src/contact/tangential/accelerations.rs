@@ -1,0 +1,110 @@
+//! The switches of everything that carries information from one evaluation or step to the
+//! next only to go faster ([`Accelerations`]). With all of them off ([`Accelerations::none`],
+//! the reference path) each step is solved from the previous state, the memory and the load
+//! alone, with every table of the chain evaluated directly. The fast path reaches the same
+//! states to the solver's tolerance, or bit for bit where a switch says so; the integration
+//! test `the_fast_path_reaches_the_reference_states` compares the two over a coupled history.
+//!
+//! The process-wide tables keyed by size (quadrature rules, Chebyshev points) are no such
+//! mechanism: they are pure functions of their key and live in `crate::cache`.
+
+use serde::Serialize;
+
+/// Which speed-ups of the spectral tangential solver are on (each `true` in [`Default`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Accelerations {
+    /// Start a step from the same step of the last phase in the same direction that began
+    /// from the same turning state, when there is one ([`super::Recalled`]; the history
+    /// driver keeps them and consults this switch). In a steady cycle that state solves the
+    /// step again, in one evaluation.
+    pub recall: bool,
+    /// Within a phase, start each attempt from the finite-difference Jacobian of the coarse
+    /// companion grid ([`Discretisation::coarse`]) at its first iterate instead of the one
+    /// carried from the previous step, or, for slip signs other than the previous step's,
+    /// instead of a fine finite-difference one (where the grid has a coarse companion). The
+    /// states are the same to the tolerance; the steps take fewer residual evaluations (the
+    /// second step of a phase that began mixed, M = 128: 8 instead of 11).
+    ///
+    /// [`Discretisation::coarse`]: crate::contact::pressure::Discretisation::coarse
+    pub coarse_jacobian: bool,
+    /// At a phase start, try the mixed slip pattern that began the last phase that began mixed
+    /// (after the standard pattern's attempts, before the other mixed ones), from its stick end
+    /// next to the edge that slipped against the phase ([`super::PhaseStart`]; the history
+    /// driver keeps it). The states are the same to the tolerance; the later reversals of a
+    /// coupled contact start their mixed attempt near their own state.
+    pub mixed_start_guesses: bool,
+    /// Within a phase, update the Jacobian by the projected secant update
+    /// (`SecantDirections`) instead of Broyden's: each update keeps the Jacobian's action on
+    /// the attempt's earlier step directions. The states are the same to the tolerance; the
+    /// steps take fewer residual evaluations.
+    pub projected_updates: bool,
+    /// Let an evaluation take the fade table of the step's last inherited link when its ramps
+    /// moved by at most `FADE_TABLE_REUSE` of their length
+    /// ([`crate::contact::Inherited::reusing_table_of`]), instead of building its own. The
+    /// transform changes by about `2.4e−6 (δ/r)²` of its largest value (δ the ramps' move,
+    /// r their length), round-off at the largest move it accepts.
+    pub fade_table_reuse: bool,
+    /// Keep the parts of a step's recent evaluations that depend on only two of the four
+    /// unknowns (`Reused`) for the evaluations of its finite-difference Jacobians.
+    /// Bit-identical: a part is taken only where it is the one the evaluation would compute.
+    pub reused_parts: bool,
+    /// Lend each thread's inner-iteration matrices from step to step (`LentMaps`, kept in
+    /// `crate::cache`) instead of allocating them at every step. Bit-identical: every
+    /// evaluation refills all of them.
+    pub lent_maps: bool,
+    /// Let the stick zones the solver accepts tabulate `H'q̃` and q̃ piecewise when they
+    /// begin a phase ([`StickZone::tabulate`], which the history driver calls on the turning
+    /// state), instead of summing their chains at every evaluation. The zone of normal
+    /// loading has its own switch ([`NormalOptions::zone_tables`]).
+    ///
+    /// [`StickZone::tabulate`]: crate::contact::StickZone::tabulate
+    /// [`NormalOptions::zone_tables`]: crate::contact::normal::NormalOptions::zone_tables
+    pub chain_tables: bool,
+    /// Let the stick zones the solver accepts tabulate their transform beside their ends
+    /// once a batch of points there is long enough to pay for it (exterior tables,
+    /// `EXTERIOR_TABLE_POINTS`; the slip checks and increments of the steps a zone ends and
+    /// begins).
+    pub exterior_tables: bool,
+}
+
+impl Default for Accelerations {
+    /// Every speed-up on: the fast path.
+    fn default() -> Self {
+        Self {
+            recall: true,
+            coarse_jacobian: true,
+            mixed_start_guesses: true,
+            projected_updates: true,
+            fade_table_reuse: true,
+            reused_parts: true,
+            lent_maps: true,
+            chain_tables: true,
+            exterior_tables: true,
+        }
+    }
+}
+
+impl Accelerations {
+    /// Every speed-up off: the reference path.
+    pub fn none() -> Self {
+        Self {
+            recall: false,
+            coarse_jacobian: false,
+            mixed_start_guesses: false,
+            projected_updates: false,
+            fade_table_reuse: false,
+            reused_parts: false,
+            lent_maps: false,
+            chain_tables: false,
+            exterior_tables: false,
+        }
+    }
+
+    /// Which tables the zones the solver accepts may build.
+    pub(crate) fn zone_tables(self) -> crate::contact::ZoneTables {
+        crate::contact::ZoneTables {
+            chain: self.chain_tables,
+            exterior: self.exterior_tables,
+        }
+    }
+}
