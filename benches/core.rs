@@ -151,7 +151,7 @@ fn steps(c: &mut Criterion) {
         0.35,
         options,
     );
-    // The same without the coarse grid's Jacobian (`SlipOptions::coarse_jacobian`), on the
+    // The same without the coarse grid's Jacobian (`Accelerations::coarse_jacobian`), on the
     // grids that have one: the comparison under the same host load.
     let mut carried = options;
     carried.accelerations.coarse_jacobian = false;
@@ -235,7 +235,7 @@ fn per_step(iters: u64, count: usize, mut steps: impl FnMut()) -> std::time::Dur
 fn recalled(c: &mut Criterion) {
     // The same step, 0.30 → 0.35 ηP, in the third forward phase of the default history: that
     // phase began from the same turning state (−½ ηP) as the second, whose step at 0.35 ηP
-    // it recalls (`SlipOptions::recall`).
+    // it recalls (`Accelerations::recall`).
     let mut loads = default_loads(1);
     loads.extend((1..=20).map(|i| 0.5 - 0.05 * i as f64));
     loads.extend((1..=16).map(|i| -0.5 + 0.05 * i as f64));
@@ -255,7 +255,7 @@ fn reversal(c: &mut Criterion) {
     bench_step(c, "solve/reversal_step", &SIZES, &default_loads(0), 0.45);
     // The first step after the next turning point, at −½ηP: it begins in the mixed slip
     // pattern that began the phase before, whose attempt starts from that phase's edge
-    // (`SlipOptions::mixed_start_guesses`).
+    // (`Accelerations::mixed_start_guesses`).
     let mut loads = default_loads(0);
     loads.extend((1..=20).map(|i| 0.5 - 0.05 * i as f64));
     bench_step(c, "solve/later_reversal_step", &SIZES, &loads, -0.45);

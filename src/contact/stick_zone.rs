@@ -833,6 +833,38 @@ mod tests {
     use super::super::tests::{faded_chain, worst_relative};
     use super::*;
 
+    /// A zone that may build no table builds none, and keeps that when written and read back;
+    /// a zone that may build all of them writes nothing of it (the serde form of the default
+    /// path is unchanged).
+    #[test]
+    fn a_zone_without_tables_builds_none_and_reads_back_so() {
+        let none = ZoneTables {
+            chain: false,
+            exterior: false,
+        };
+        let zone = StickZone {
+            tables: none,
+            ..faded_chain(24, Some(96), Vec::new())
+        };
+        zone.tabulate(96);
+        let width = zone.hi - zone.lo;
+        let outside: Vec<f64> = (0..2 * EXTERIOR_TABLE_POINTS)
+            .map(|k| zone.hi + width * (k as f64 + 0.5) / (2 * EXTERIOR_TABLE_POINTS) as f64)
+            .collect();
+        let mut out = Vec::new();
+        zone.correction_cauchys_into(&outside, &mut out);
+        assert!(zone.cauchy_table.0.get().is_none() && zone.value_table.0.get().is_none());
+        assert!(zone.exterior_table.0.get().is_none());
+        let text = crate::shared::write_shared(|| serde_json::to_string(&zone)).unwrap();
+        let read: StickZone = crate::shared::read_shared(|| serde_json::from_str(&text)).unwrap();
+        assert_eq!(read.tables, none);
+        let all = faded_chain(24, Some(96), Vec::new());
+        let text = crate::shared::write_shared(|| serde_json::to_string(&all)).unwrap();
+        assert!(!text.contains("\"tables\""), "{text}");
+        let read: StickZone = crate::shared::read_shared(|| serde_json::from_str(&text)).unwrap();
+        assert_eq!(read.tables, ZoneTables::default());
+    }
+
     #[test]
     fn tabulated_cauchy_transform_matches_the_direct_one() {
         // A normal-loading-like zone (centre kink) faded into a narrower zone with a series of

@@ -1,5 +1,6 @@
 //! The one integration-test binary: reference solutions, scenarios and the command line.
 
+mod accelerations;
 mod cli;
 mod fuzz;
 mod hybrid;

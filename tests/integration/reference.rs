@@ -1530,7 +1530,7 @@ fn pipelined_history_matches_sequential_steps() {
 }
 
 /// A phase that begins from the same turning state as an earlier phase of its direction
-/// recalls that phase's steps (`SlipOptions::recall`): the default history (M = 32, steps of
+/// recalls that phase's steps (`Accelerations::recall`): the default history (M = 32, steps of
 /// 0.05 ηP) through three ±½ ηP cycles, with and without recall. Forward phase 3 repeats
 /// forward phase 2 and reverse phase 3 repeats reverse phase 2 (reverse phase 1 began from
 /// the first loading's state and is not recalled). Measured: every recalled step takes one
@@ -1557,11 +1557,11 @@ fn recalled_cycles_repeat_the_solved_ones() {
 }
 
 /// Within a phase a step starts from the coarse grid's finite-difference Jacobian
-/// (`SlipOptions::coarse_jacobian`) instead of the one carried from the previous step: the
+/// (`Accelerations::coarse_jacobian`) instead of the one carried from the previous step: the
 /// default history (M = 96, the coarsest grid with a coarse companion being 72, steps of
 /// 0.05 ηP) through three ±½ ηP cycles, with and without. The states are the same to the
 /// solver's tolerance and the steps take fewer residual evaluations. Measured (with the
-/// projected update, `SlipOptions::projected_updates`): 448 against 508 evaluations at the
+/// projected update, `Accelerations::projected_updates`): 448 against 508 evaluations at the
 /// solver tolerance 1e−11. The count without the option moves by about 1 % with the
 /// round-off of the products and quadratures, so the bound is nineteen twentieths; the
 /// records differ by at most 1.2e−11 a in the geometry and δ and 9.8e−11 of the largest step
@@ -1598,7 +1598,7 @@ fn coarse_jacobians_reach_the_same_states_in_fewer_evaluations() {
 }
 
 /// Within a phase the Jacobian is updated by the projected secant update
-/// (`SlipOptions::projected_updates`) instead of Broyden's: the default history (M = 32, no
+/// (`Accelerations::projected_updates`) instead of Broyden's: the default history (M = 32, no
 /// coarse grid, so every step within a phase starts from the Jacobian carried from the
 /// previous one) through three ±½ ηP cycles, with and without. The states are the same to the
 /// solver's tolerance (bounds as for recalled steps) and the steps take fewer residual
@@ -1617,7 +1617,7 @@ fn projected_updates_reach_the_same_states_in_fewer_evaluations() {
 }
 
 /// A phase start tries the mixed slip pattern that began the last phase, from its stick end
-/// next to the edge that slipped against that phase (`SlipOptions::mixed_start_guesses`):
+/// next to the edge that slipped against that phase (`Accelerations::mixed_start_guesses`):
 /// the default history (M = 32) through three ±½ ηP cycles, with and without. The first
 /// reversal (phase 2) has no predecessor and is solved alike; the next two (phases 3 and 4)
 /// begin mixed as it did and take fewer evaluations; phases 5 and 6 are recalled. The states

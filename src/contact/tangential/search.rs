@@ -40,7 +40,7 @@ const RECALL_RESIDUAL: f64 = 1e-9;
 /// they start from `start`'s). `recalled`, when given, is tried first (see [`Recalled`]);
 /// `last_start`, at a phase start, is how the last phase that began mixed began: its pattern
 /// is then tried after the standard one's attempts and before the other mixed ones, from its
-/// remembered edge ([`PhaseStart`], [`SlipOptions::mixed_start_guesses`]).
+/// remembered edge ([`PhaseStart`], [`Accelerations::mixed_start_guesses`](super::Accelerations::mixed_start_guesses)).
 #[allow(clippy::too_many_arguments)]
 pub fn solve_slip(
     model: &ContactModel,
@@ -439,12 +439,12 @@ impl Attempts {
 enum Method<'a> {
     /// Secant updates within the evaluation budget (projected within a phase, Broyden's at a
     /// phase start: [`Method::within_phase`]), from the given Jacobian (the previous step's)
-    /// or, with [`SlipOptions::coarse_jacobian`] and a coarse grid, from the coarse grid's at
+    /// or, with [`Accelerations::coarse_jacobian`](super::Accelerations::coarse_jacobian) and a coarse grid, from the coarse grid's at
     /// the first iterate; without one, from a finite-difference Jacobian.
     Broyden(Option<[[f64; 4]; 4]>),
     /// Secant updates within a phase for slip signs other than the previous step's (whose
     /// Jacobian does not apply): from the coarse grid's Jacobian at the first iterate with
-    /// [`SlipOptions::coarse_jacobian`] and a coarse grid, else a finite-difference one.
+    /// [`Accelerations::coarse_jacobian`](super::Accelerations::coarse_jacobian) and a coarse grid, else a finite-difference one.
     Coarse,
     /// Newton's method with a finite-difference Jacobian at every iterate and five times the
     /// evaluation budget: slower, and the fallback where the quasi-Newton attempts all fail.
@@ -610,7 +610,7 @@ impl GeometrySearch<'_> {
     /// replaces the carried one. Its evaluations are not counted: they are the coarse grid's.
     /// It saves residual evaluations because within a phase the geometry changes little, so
     /// the coarse Jacobian at the current iterate is closer than the carried one; the states
-    /// are the same to the tolerance ([`SlipOptions::coarse_jacobian`]). At a phase start the
+    /// are the same to the tolerance ([`Accelerations::coarse_jacobian`](super::Accelerations::coarse_jacobian)). At a phase start the
     /// fine one is kept: there a coarse Jacobian can steer the iteration to another admissible
     /// state.
     fn starting_jacobian(
