@@ -63,13 +63,12 @@ type SwitchOff = fn(&mut Accelerations);
 /// Every speed-up on, each one off, and all off.
 fn variants() -> Vec<(String, Accelerations)> {
     let on = Accelerations::default();
-    let off: [(&str, SwitchOff); 9] = [
+    let off: [(&str, SwitchOff); 8] = [
         ("recall", |a| a.recall = false),
         ("coarse_jacobian", |a| a.coarse_jacobian = false),
         ("mixed_start_guesses", |a| a.mixed_start_guesses = false),
         ("projected_updates", |a| a.projected_updates = false),
         ("fade_table_reuse", |a| a.fade_table_reuse = false),
-        ("reused_parts", |a| a.reused_parts = false),
         ("lent_maps", |a| a.lent_maps = false),
         ("chain_tables", |a| a.chain_tables = false),
         ("exterior_tables", |a| a.exterior_tables = false),

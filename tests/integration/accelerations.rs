@@ -133,13 +133,12 @@ fn the_fast_path_reaches_the_reference_states() {
     assert!(fast_evaluations < reference_evaluations);
 }
 
-/// The speed-ups said to change no bit (`reused_parts`, `lent_maps`) change no bit of a run.
+/// The speed-up said to change no bit (`lent_maps`) changes no bit of a run.
 #[test]
-fn reused_parts_and_lent_maps_change_no_bit() {
+fn lent_maps_change_no_bit() {
     let fast = default_run(Accelerations::default(), ZoneTables::default());
     let without = default_run(
         Accelerations {
-            reused_parts: false,
             lent_maps: false,
             ..Accelerations::default()
         },
@@ -180,7 +179,6 @@ fn the_default_options_are_the_fast_path() {
             || none.mixed_start_guesses
             || none.projected_updates
             || none.fade_table_reuse
-            || none.reused_parts
             || none.lent_maps
             || none.chain_tables
             || none.exterior_tables)

@@ -44,10 +44,6 @@ pub struct Accelerations {
     /// transform changes by about `2.4e−6 (δ/r)²` of its largest value (δ the ramps' move,
     /// r their length), round-off at the largest move it accepts.
     pub fade_table_reuse: bool,
-    /// Keep the parts of a step's recent evaluations that depend on only two of the four
-    /// unknowns (`Reused`) for the evaluations of its finite-difference Jacobians.
-    /// Bit-identical: a part is taken only where it is the one the evaluation would compute.
-    pub reused_parts: bool,
     /// Lend each thread's inner-iteration matrices from step to step (`LentMaps`, kept in
     /// `crate::cache`) instead of allocating them at every step. Bit-identical: every
     /// evaluation refills all of them.
@@ -76,7 +72,6 @@ impl Default for Accelerations {
             mixed_start_guesses: true,
             projected_updates: true,
             fade_table_reuse: true,
-            reused_parts: true,
             lent_maps: true,
             chain_tables: true,
             exterior_tables: true,
@@ -93,7 +88,6 @@ impl Accelerations {
             mixed_start_guesses: false,
             projected_updates: false,
             fade_table_reuse: false,
-            reused_parts: false,
             lent_maps: false,
             chain_tables: false,
             exterior_tables: false,

@@ -438,7 +438,6 @@ mod tests {
 
     use super::inner::InnerMaps;
     use super::residual::StepProblem;
-    use super::reuse::Reused;
     use super::*;
     use crate::contact::pressure::Discretisation;
     use crate::contact::{Inherited, StickZone};
@@ -470,7 +469,7 @@ mod tests {
         driver: &'a crate::history::DriverState,
         base: Option<&'a Arc<StickZone>>,
         maps: &'a RefCell<InnerMaps>,
-        (last_link, reused): (&'a RefCell<Option<Arc<Inherited>>>, &'a RefCell<Reused>),
+        last_link: &'a RefCell<Option<Arc<Inherited>>>,
     ) -> StepProblem<'a> {
         StepProblem {
             model: &sc.model,
@@ -482,7 +481,6 @@ mod tests {
             tangential_load: driver.state.tangential_load,
             scratch: maps,
             last_link,
-            reused,
             accelerations: Accelerations::default(),
         }
     }

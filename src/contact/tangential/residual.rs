@@ -22,7 +22,12 @@ use super::Accelerations;
 use super::inner::{InnerMaps, StickSums};
 use super::kinks::{EndProbes, KinkMaps, KinkPoints, pressure_root, resolved};
 use super::linalg::Anderson;
-use super::reuse::{PartsKey, Reused, SampleParts, StickParts};
+
+/// `(H'q̃ of the chain, remembered strain)` at the stick points.
+type StickParts = (Vec<f64>, Vec<f64>);
+
+/// `(S, inherited traction)` at the pressure points and at the charge points.
+type SampleParts = (Vec<(f64, f64)>, Vec<(f64, f64)>);
 
 /// The four geometric unknowns of a step: stick-zone ends and contact half-width and centre.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -67,11 +72,7 @@ pub(super) struct StepProblem<'a> {
     /// when its ramps have hardly moved ([`Inherited::reusing_table_of`]; one for all the
     /// attempts of a step, on both grids).
     pub(super) last_link: &'a RefCell<Option<Arc<Inherited>>>,
-    /// The parts of the last evaluations that depend on the geometry through the stick
-    /// points or through the sample points alone ([`Reused`]; one for all the attempts of a
-    /// step, on both grids).
-    pub(super) reused: &'a RefCell<Reused>,
-    /// The speed-ups in use (`fade_table_reuse`, `reused_parts`, the accepted zones' tables).
+    /// The speed-ups in use (`fade_table_reuse`, the accepted zones' tables).
     pub(super) accelerations: Accelerations,
 }
 
@@ -150,7 +151,7 @@ impl StepProblem<'_> {
         let mixed = (self.signs.0 - self.signs.1).abs() > 0.0;
         // The traction at the pressure and charge points is `η p S + q̃_own + q̃_inherited`;
         // S and the inherited part depend on the geometry only, so they are evaluated once.
-        let sample_parts = self.sample_parts(g, &points, &closed, &state, mixed, k.conducting);
+        let sample_parts = self.sample_parts(&points, &closed, &state, k.conducting);
         let fixed_c = &sample_parts.1;
         let (np, nc) = (points.pressure.len(), fixed_c.len());
         let sample_points: Vec<f64> = points
@@ -296,28 +297,14 @@ impl StepProblem<'_> {
             .collect()
     }
 
-    /// `H'` of the fixed part of q̃ and the remembered strain at the stick points, taken from
-    /// [`Reused`] when an evaluation of the step at the same stick ends (and the same fixed
-    /// part) made them. This saves the chain's sums in the evaluations of a finite-difference
-    /// Jacobian that move a or c only; the entry is what the evaluation would compute, bit for
-    /// bit, so the result does not change.
-    fn stick_parts(&self, points: &Points, closed: &StickZone) -> Arc<StickParts> {
+    /// `H'` of the fixed part of q̃ and the remembered strain at the stick points.
+    fn stick_parts(&self, points: &Points, closed: &StickZone) -> StickParts {
         let m = self.disc.nodes();
-        let make = || {
-            let (mut chain, mut remembered) = (Vec::with_capacity(m), Vec::with_capacity(m));
-            closed.correction_cauchys_into(&points.stick, &mut chain);
-            self.memory
-                .strains_into(self.model, &points.stick, &mut remembered);
-            (chain, remembered)
-        };
-        if !self.accelerations.reused_parts {
-            return Arc::new(make());
-        }
-        Reused::get_or_make(
-            &mut self.reused.borrow_mut().stick,
-            PartsKey::new(m, (points.mid, points.half), closed, [0.0; 2]),
-            make,
-        )
+        let (mut chain, mut remembered) = (Vec::with_capacity(m), Vec::with_capacity(m));
+        closed.correction_cauchys_into(&points.stick, &mut chain);
+        self.memory
+            .strains_into(self.model, &points.stick, &mut remembered);
+        (chain, remembered)
     }
 
     /// The state the inner iteration starts from and updates: `guess` with this evaluation's
@@ -336,21 +323,14 @@ impl StepProblem<'_> {
     }
 
     /// `(S, inherited traction)` at the pressure points and (conducting punch) at the charge
-    /// points, the parts of the traction there that depend on the geometry only; taken from
-    /// [`Reused`] when an evaluation of the step on the same contact (and, for mixed slip
-    /// signs, the same stick ends) made them. This saves the chain's sums in the evaluations
-    /// of a finite-difference Jacobian that move a stick end only; the entry is what the
-    /// evaluation would compute, bit for bit, so the result does not change.
+    /// points, the parts of the traction there that depend on the geometry only.
     fn sample_parts(
         &self,
-        g: &Geometry,
         points: &Points,
         closed: &StickZone,
         state: &ContactState,
-        mixed: bool,
         conducting: bool,
-    ) -> Arc<SampleParts> {
-        let m = self.disc.nodes();
+    ) -> SampleParts {
         let sampled = |points: &[f64]| -> Vec<(f64, f64)> {
             let mut inherited = Vec::with_capacity(points.len());
             closed.corrections_into(points, &mut inherited);
@@ -360,23 +340,12 @@ impl StepProblem<'_> {
                 .map(|(&x, inh)| (state.slip_shape(x), inh))
                 .collect()
         };
-        let make = || {
-            let charge = if conducting {
-                sampled(&points.charge)
-            } else {
-                Vec::new()
-            };
-            (sampled(&points.pressure), charge)
+        let charge = if conducting {
+            sampled(&points.charge)
+        } else {
+            Vec::new()
         };
-        if !self.accelerations.reused_parts {
-            return Arc::new(make());
-        }
-        let ends = if mixed { [g.lo, g.hi] } else { [0.0; 2] };
-        Reused::get_or_make(
-            &mut self.reused.borrow_mut().samples,
-            PartsKey::new(m, (g.c, g.a), closed, ends),
-            make,
-        )
+        (sampled(&points.pressure), charge)
     }
 
     /// The inner iteration's maps ([`InnerMaps`]) at `state`'s geometry, refilled into the
@@ -520,7 +489,6 @@ impl Couplings {
 /// The collocation points of one evaluation: the bounded grid's on the stick zone
 /// `mid ± half`, the bounded and the unbounded grid's on the contact `c ± a`.
 struct Points {
-    mid: f64,
     half: f64,
     stick: Vec<f64>,
     pressure: Vec<f64>,
@@ -535,7 +503,6 @@ impl Points {
             points.iter().map(|t| centre + half * t).collect()
         };
         Self {
-            mid,
             half,
             stick: mapped(&disc.bounded.collocation, mid, half),
             pressure: mapped(&disc.bounded.collocation, g.c, g.a),

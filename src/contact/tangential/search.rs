@@ -19,7 +19,7 @@ use super::residual::{
     Geometry, INNER_TOLERANCE, JACOBIAN_INNER_TOLERANCE, LOOSEST_INNER_TOLERANCE, StepProblem,
     inner_tolerance,
 };
-use super::reuse::{LentMaps, Reused};
+use super::reuse::LentMaps;
 use super::{
     PhaseStart, Recalled, SlipOptions, SlipPattern, SlipStep, StepAdmissibility, WarmStart,
 };
@@ -93,7 +93,6 @@ pub fn solve_slip(
     let mut attempts = Attempts::default();
     let scratch = LentMaps::lend(false, options.lent_maps);
     let last_link = RefCell::new(None);
-    let reused = RefCell::new(Reused::default());
     let problem_for = |signs: (f64, f64)| StepProblem {
         model,
         disc,
@@ -104,7 +103,6 @@ pub fn solve_slip(
         tangential_load,
         scratch: &scratch.0,
         last_link: &last_link,
-        reused: &reused,
         accelerations: options.accelerations,
     };
     if let Some(step) = recalled.and_then(|r| recall(&problem_for, start, r, options)) {
@@ -863,15 +861,9 @@ mod tests {
             let at_state = |driver: &DriverState| {
                 let state = &driver.state;
                 let g = Geometry::of(state).expect("slip state");
-                let (last_link, reused) = (RefCell::new(None), RefCell::new(Reused::default()));
-                let problem = forward_problem(
-                    &sc,
-                    &disc,
-                    driver,
-                    base.as_ref(),
-                    &maps.0,
-                    (&last_link, &reused),
-                );
+                let last_link = RefCell::new(None);
+                let problem =
+                    forward_problem(&sc, &disc, driver, base.as_ref(), &maps.0, &last_link);
                 let (r, solved, _) = problem.evaluate(&g, state, INNER_TOLERANCE).unwrap();
                 // The state is a converged one: its residual again below the solver's tolerance.
                 let tolerance = SlipOptions::default().tolerance;
