@@ -302,7 +302,14 @@ pub fn try_step(
             driver.phase_start_load,
         ),
     };
-    let (guesses, contact) = starting_geometry(model, driver, (q, sign, dq), new_phase, start_load);
+    let continuation = options.accelerations.continuation;
+    let (guesses, contact) = starting_geometry(
+        model,
+        driver,
+        (q, sign, dq),
+        (new_phase, continuation),
+        start_load,
+    );
     // The same step of the last phase in this direction that began from the same turning
     // state: in a steady cycle it solves this step again.
     let phase_start = if new_phase {
@@ -311,7 +318,7 @@ pub fn try_step(
         driver.traces.current.as_ref().map(|t| t.start)
     };
     let traced = phase_start
-        .filter(|_| options.recall)
+        .filter(|_| options.accelerations.recall)
         .and_then(|start| driver.traces.recall(&start, sign, q, limit))
         .cloned();
     // The recalled step's checks go with it when this step begins from its start.
@@ -402,11 +409,13 @@ fn starting_geometry(
     model: &ContactModel,
     driver: &DriverState,
     (q, sign, dq): (f64, f64, f64),
-    new_phase: bool,
+    (new_phase, continuation): (bool, bool),
     start_load: f64,
 ) -> StartingGeometry {
     let limit = model.friction * driver.state.normal_load;
-    let predicted = (!new_phase).then(|| predict(&driver.history, q)).flatten();
+    let predicted = (!new_phase && continuation)
+        .then(|| predict(&driver.history, q))
+        .flatten();
     let guess = match predicted {
         Some([lo, hi, ..]) => (lo, hi),
         None => phase_start_guess(model, &driver.state, sign, dq),
@@ -433,7 +442,9 @@ fn starting_geometry(
     // the centre by about as much as the first loading step did; started from the old centre,
     // the mixed-sign attempt of a reversal step spends about ten quasi-Newton iterations
     // getting there. The states are the same either way.)
-    let contact = if new_phase {
+    let contact = if !continuation {
+        None
+    } else if new_phase {
         driver.first_centre_slope.map(|slope| (a, c + slope * dq))
     } else {
         predicted.map(|[.., a, c]| (a, c))

@@ -61,6 +61,12 @@ pub struct Accelerations {
     /// `EXTERIOR_TABLE_POINTS`; the slip checks and increments of the steps a zone ends and
     /// begins).
     pub exterior_tables: bool,
+    /// Start a step within a phase from the stick ends, half-width and centre extrapolated
+    /// in Q through the phase's last three steps, and a phase's first step from the centre
+    /// moved by dc/dQ of the previous phase's first step (the history driver's `predict`);
+    /// off, from the Mindlin–Deresiewicz guess and the previous state's contact. The states
+    /// are the same to the tolerance.
+    pub continuation: bool,
 }
 
 impl Default for Accelerations {
@@ -75,6 +81,7 @@ impl Default for Accelerations {
             lent_maps: true,
             chain_tables: true,
             exterior_tables: true,
+            continuation: true,
         }
     }
 }
@@ -91,6 +98,7 @@ impl Accelerations {
             lent_maps: false,
             chain_tables: false,
             exterior_tables: false,
+            continuation: false,
         }
     }
 

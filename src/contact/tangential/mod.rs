@@ -214,24 +214,7 @@ pub struct SlipOptions {
     pub stall_tolerance: f64,
     /// The speed-ups that carry information from one evaluation or step to the next
     /// ([`Accelerations`]; all on by default, [`Accelerations::none`] for the reference path).
-    /// Their fields also read through the options (`options.recall`), as the history driver
-    /// reads `recall`.
     pub accelerations: Accelerations,
-}
-
-/// `options.recall` and the like: the switches of [`SlipOptions::accelerations`].
-impl std::ops::Deref for SlipOptions {
-    type Target = Accelerations;
-
-    fn deref(&self) -> &Accelerations {
-        &self.accelerations
-    }
-}
-
-impl std::ops::DerefMut for SlipOptions {
-    fn deref_mut(&mut self) -> &mut Accelerations {
-        &mut self.accelerations
-    }
 }
 
 impl Default for SlipOptions {

@@ -75,7 +75,7 @@ pub fn solve_slip(
     // both converge to states that pass the checks (the edge zone thinner than what the checks
     // resolve), the standard one is the state the step reports.
     let preferred = last_start
-        .filter(|_| warm.is_none() && options.mixed_start_guesses)
+        .filter(|_| warm.is_none() && options.accelerations.mixed_start_guesses)
         .map(|last| {
             let from = contact.unwrap_or((start.half_width, start.centre));
             (
@@ -91,7 +91,7 @@ pub fn solve_slip(
         plan.insert(at, entry);
     }
     let mut attempts = Attempts::default();
-    let scratch = LentMaps::lend(false, options.lent_maps);
+    let scratch = LentMaps::lend(false, options.accelerations.lent_maps);
     let last_link = RefCell::new(None);
     let problem_for = |signs: (f64, f64)| StepProblem {
         model,
@@ -498,8 +498,8 @@ fn solve_geometry(
     // The projected update within a phase; at a phase start Broyden's (there the iteration's
     // path decides which of several admissible states it reaches: tried there too, the first
     // step of a PZT-4 first loading at M = 128 reached another state, 8e−5 a away).
-    let projected =
-        options.projected_updates && (method.within_phase() || matches!(method, Method::Recall(_)));
+    let projected = options.accelerations.projected_updates
+        && (method.within_phase() || matches!(method, Method::Recall(_)));
     let mut directions = SecantDirections::default();
     let mut iterations = 0;
     for iter in 0..options.max_iterations {
@@ -617,7 +617,7 @@ impl GeometrySearch<'_> {
         state: &ContactState,
         hint: Option<[[f64; 4]; 4]>,
     ) -> Option<[[f64; 4]; 4]> {
-        if self.options.coarse_jacobian && self.method.within_phase() {
+        if self.options.accelerations.coarse_jacobian && self.method.within_phase() {
             coarse_jacobian(self.problem, g, state).or(hint)
         } else {
             hint
