@@ -242,8 +242,10 @@ pub struct GeneralRun {
     /// the last step.
     works: [[f64; 2]; 2],
     /// Steps after which the spectral solver next tries to take the state back (within the
-    /// phase of the handover): 1, then doubled after each try that fails, so that a phase the
-    /// spectral solver cannot represent costs a few of its attempts, not one a step.
+    /// phase of the handover): 2, then doubled after each try that fails, so that a phase the
+    /// spectral solver cannot represent costs a few of its attempts, not one a step. Not 1:
+    /// after the handover's own step the try would be the step the spectral solver just failed
+    /// (or that the general solver's check contradicted), from the same state.
     resume_at: usize,
 }
 
@@ -314,7 +316,7 @@ impl GeneralRun {
             steps: 0,
             first_began_at_handover: false,
             works: [[0.0; 2]; 2],
-            resume_at: 1,
+            resume_at: 2,
         }
     }
 
@@ -336,9 +338,10 @@ impl GeneralRun {
     }
 
     /// Whether the spectral solver is due to try to take the state back after this run's
-    /// last step (see `resume_at`).
-    pub fn resume_due(&self) -> bool {
-        self.steps >= self.resume_at
+    /// last step (see `resume_at`); `last_of_phase`: that step ends the phase, after which the
+    /// spectral solver's memory no longer holds (tried then unless it is the handover's step).
+    pub fn resume_due(&self, last_of_phase: bool) -> bool {
+        self.steps >= self.resume_at || (last_of_phase && self.steps >= 2)
     }
 
     /// A try to take the state back failed: the next one after twice as many steps.

@@ -44,7 +44,7 @@
 //! own increments. Under [`SolverChoice::Auto`] the general solver also takes the first step
 //! of every phase, where thin end zones that slip the old way form in a coupled contact, and
 //! the spectral solver's step is handed over when the two disagree. The spectral solver tries
-//! to take the state back after 1, 2, 4, … general steps of the phase (a try costs about as
+//! to take the state back after 2, 4, 8, … general steps of the phase and at its last step (a try costs about as
 //! much as a spectral step that fails, many general steps). Each record says which solver took
 //! the step ([`SolverKind`]) and the zone structure ([`ZoneCount`]).
 //!

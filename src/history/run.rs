@@ -218,9 +218,9 @@ fn current_load(state: &HistoryState) -> f64 {
 /// cycles. Returns those increments from the state of the handover (δ, and the works of P and
 /// of the electric load, which are differences of state functions too).
 ///
-/// Tried after 1, 2, 4, … general steps of the phase ([`GeneralRun::resume_due`]), and at
-/// the step that ends the phase (`last_of_phase`, a turning point of the load): after it the
-/// spectral solver's memory no longer holds.
+/// Tried after 2, 4, 8, … general steps of the phase and at the step that ends the phase
+/// (`last_of_phase`, a turning point of the load), after which the spectral solver's memory no
+/// longer holds ([`GeneralRun::resume_due`]).
 fn resumes(
     model: &ContactModel,
     disc: &Discretisation,
@@ -234,7 +234,7 @@ fn resumes(
     if !same_phase || last.regime.slip_sign().is_none() {
         return None;
     }
-    if !run.resume_due() && !last_of_phase {
+    if !run.resume_due(last_of_phase) {
         return None;
     }
     match try_step(model, disc, driver, point, options) {
