@@ -81,12 +81,14 @@ pub struct RunOptions {
 
 impl RunOptions {
     /// The default options for a choice of solver. Under [`SolverChoice::Auto`] the spectral
-    /// solver accepts no step at a stalled residual (`stall_tolerance` 0): the general solver
-    /// takes such a step instead.
+    /// solver has no last resorts: it accepts no step at a stalled residual
+    /// (`stall_tolerance` 0) and does not repeat its failed attempts with Newton's method
+    /// (`newton_fallback` off); the general solver takes such a step instead.
     pub fn new(solver: SolverChoice) -> Self {
         let slip = match solver {
             SolverChoice::Auto => SlipOptions {
                 stall_tolerance: 0.0,
+                newton_fallback: false,
                 ..SlipOptions::default()
             },
             _ => SlipOptions::default(),

@@ -212,6 +212,12 @@ pub struct SlipOptions {
     /// by 1e−3 a in one stick end, the size of the discretisation error of the stick ends at
     /// M = 64 (convergence study in `docs/performance.md`), and the next step is unaffected.
     pub stall_tolerance: f64,
+    /// When no attempt of the quasi-Newton iteration converges, make the attempts again with
+    /// Newton's method (finite-difference Jacobians at every iterate), which finds roots near
+    /// the jumps to remembered boundaries that the quasi-Newton iteration can miss. Off where
+    /// another solver takes the steps this one fails (`numerics.solver = auto`): a step that
+    /// fails both ways costs about twice the evaluations of its quasi-Newton attempts.
+    pub newton_fallback: bool,
     /// The speed-ups that carry information from one evaluation or step to the next
     /// ([`Accelerations`]; all on by default, [`Accelerations::none`] for the reference path).
     pub accelerations: Accelerations,
@@ -225,6 +231,7 @@ impl Default for SlipOptions {
             max_evaluations: 60,
             admissibility: 1e-3,
             stall_tolerance: 1e-4,
+            newton_fallback: true,
             accelerations: Accelerations::default(),
         }
     }

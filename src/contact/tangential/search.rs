@@ -113,7 +113,12 @@ pub fn solve_slip(
     }
     // Every attempt is made with the fast quasi-Newton iteration first; the jumps above are
     // where it can miss a root that Newton's method finds, so Newton's method is the fallback.
-    'attempts: for newton in [false, true] {
+    let rounds: &[bool] = if options.newton_fallback {
+        &[false, true]
+    } else {
+        &[false]
+    };
+    'attempts: for &newton in rounds {
         for &(pattern, guess) in &plan {
             let signs = pattern.signs();
             if attempts.stalled.is_some() {
