@@ -102,7 +102,7 @@ pub use record::{
     NoObserver, Observer, SolvedState, SolvedStateData, StateView, StepFailure, StepRecord,
 };
 pub use regime::{PhaseEvent, Regime, next_regime, phase_event};
-pub use run::{HistoryFailure, HistoryRun, continue_run, run_history, turning_points};
+pub use run::{HistoryFailure, HistoryRun, continue_run, run_from, run_history, turning_points};
 pub use state::{HistoryState, HistoryStateData, HistoryStateView};
 
 #[cfg(test)]

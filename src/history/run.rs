@@ -47,15 +47,28 @@ pub fn run_history(
 ) -> Result<HistoryRun, Box<HistoryFailure>> {
     let driver = DriverState::after_normal_loading(normal);
     let t0 = history.points.first().map_or(0.0, |p| p.0);
-    let mut records = vec![record(0, t0, &driver, Regime::NormalLoading, None)];
+    let records = vec![record(0, t0, &driver, Regime::NormalLoading, None)];
     observer.on_step(&records[0], StateView::Spectral(&driver.state));
-    let mut state = HistoryState::new(driver);
+    let state = HistoryState::new(driver);
     let points = history.load_points();
+    run_from(model, disc, (state, records), &points, options, observer)
+}
+
+/// Walk `points` from `state`, after the steps `records` taken to reach it, as
+/// [`continue_run`] does: the finished run, or what was accepted before a failure.
+pub fn run_from(
+    model: &ContactModel,
+    disc: &Discretisation,
+    (mut state, mut records): (HistoryState, Vec<StepRecord>),
+    points: &[LoadPoint],
+    options: RunOptions,
+    observer: &mut dyn Observer,
+) -> Result<HistoryRun, Box<HistoryFailure>> {
     let failure = continue_run(
         model,
         disc,
         &mut state,
-        &points,
+        points,
         options,
         observer,
         &mut records,

@@ -393,7 +393,7 @@ fn resume_history(
     model: &crate::contact::ContactModel,
     disc: &Discretisation,
     history: &crate::history::LoadHistory,
-    (step, mut records, mut state): (usize, Vec<StepRecord>, crate::history::HistoryState),
+    (step, records, state): (usize, Vec<StepRecord>, crate::history::HistoryState),
     options: RunOptions,
     observer: &mut dyn crate::history::Observer,
 ) -> Result<crate::history::HistoryRun, Box<crate::history::HistoryFailure>> {
@@ -402,23 +402,7 @@ fn resume_history(
         .into_iter()
         .filter(|p| p.step > step)
         .collect();
-    let failure = crate::history::continue_run(
-        model,
-        disc,
-        &mut state,
-        &points,
-        options,
-        observer,
-        &mut records,
-    );
-    match failure {
-        None => Ok(crate::history::HistoryRun { records, state }),
-        Some(failure) => Err(Box::new(crate::history::HistoryFailure {
-            records,
-            state,
-            failure,
-        })),
-    }
+    crate::history::run_from(model, disc, (state, records), &points, options, observer)
 }
 
 /// The contact and stick-zone ends of a state, for the marks of its field plots: the

@@ -179,9 +179,13 @@ pub(crate) fn paused_run(scenario: Option<&Path>, out: &Path, stage: &str) -> Ch
     if let Some(s) = scenario {
         cmd.arg(s);
     }
+    cmd.arg("--out").arg(out);
+    paused(cmd, stage)
+}
+
+/// Start `cmd` (a run) so that it pauses at `stage` and wait until it is there.
+pub(crate) fn paused(mut cmd: Command, stage: &str) -> Child {
     let mut child = cmd
-        .arg("--out")
-        .arg(out)
         .arg("--quiet")
         .env("FRETSIM_PAUSE_AT", stage)
         .stdout(Stdio::null())

@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::Output;
 
 use crate::cli::{fretsim, scenario_path};
-use crate::output_safety::{paused_run, snapshot};
+use crate::output_safety::{paused, paused_run, snapshot};
 
 fn resume(scenario: Option<&Path>, dir: &Path, pause: Option<&str>) -> Output {
     let mut cmd = fretsim();
@@ -80,31 +80,13 @@ fn killed(mut child: std::process::Child) {
 
 /// A resumed run that pauses at `stage`, started and waited for as [`paused_run`] does.
 fn paused_run_resuming(scenario: Option<&Path>, dir: &Path, stage: &str) -> std::process::Child {
-    use std::io::{BufRead, BufReader};
     let mut cmd = fretsim();
     cmd.arg("run");
     if let Some(s) = scenario {
         cmd.arg(s);
     }
-    let mut child = cmd
-        .arg("--resume")
-        .arg(dir)
-        .arg("--quiet")
-        .env("FRETSIM_PAUSE_AT", stage)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
-    let wanted = format!("fretsim: paused at {stage}");
-    loop {
-        match lines.next() {
-            Some(Ok(line)) if line == wanted => break,
-            Some(Ok(_)) => continue,
-            _ => panic!("the resumed run ended before it paused at {stage}"),
-        }
-    }
-    child
+    cmd.arg("--resume").arg(dir);
+    paused(cmd, stage)
 }
 
 /// `--resume` with another scenario than the checkpoint's: exit 2, a message that says so,
