@@ -27,9 +27,15 @@ pub fn write_shared<R>(write: impl FnOnce() -> R) -> R {
         return write();
     }
     WRITTEN.with(|w| *w.borrow_mut() = Some(HashMap::new()));
-    let result = write();
-    WRITTEN.with(|w| *w.borrow_mut() = None);
-    result
+    // Ended when dropped, also when `write` unwinds.
+    struct Scope;
+    impl Drop for Scope {
+        fn drop(&mut self) {
+            WRITTEN.with(|w| *w.borrow_mut() = None);
+        }
+    }
+    let _scope = Scope;
+    write()
 }
 
 /// Run `read` (a deserialisation) of what [`write_shared`] wrote; inside another
@@ -39,9 +45,14 @@ pub fn read_shared<R>(read: impl FnOnce() -> R) -> R {
         return read();
     }
     READ.with(|r| *r.borrow_mut() = Some(HashMap::new()));
-    let result = read();
-    READ.with(|r| *r.borrow_mut() = None);
-    result
+    struct Scope;
+    impl Drop for Scope {
+        fn drop(&mut self) {
+            READ.with(|r| *r.borrow_mut() = None);
+        }
+    }
+    let _scope = Scope;
+    read()
 }
 
 #[derive(Serialize)]

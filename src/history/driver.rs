@@ -248,25 +248,14 @@ impl Trial {
     /// The record the step will have once committed to `driver` (the driver it was tried
     /// from), without its increments.
     pub fn record(&self, driver: &DriverState) -> StepRecord {
-        let mut preview = record(
-            self.point.step,
-            self.point.t,
-            driver,
+        let phase = driver.phase + usize::from(self.begins.is_some());
+        record_of(
+            (self.point.step, self.point.t),
+            &self.solved.state,
+            (phase, driver.displacement),
             self.regime,
             Some(&self.solved),
-        );
-        let s = &self.solved.state;
-        let stick = s.traction.stick.as_ref().expect("slip state");
-        preview.phase = driver.phase + usize::from(self.begins.is_some());
-        preview.q = s.tangential_load;
-        preview.half_width = s.half_width;
-        preview.eccentricity = -s.centre;
-        preview.stick_lo = stick.lo;
-        preview.stick_hi = stick.hi;
-        preview.left_slip_sign = s.traction.left_sign;
-        preview.right_slip_sign = s.traction.right_sign;
-        preview.zones = ZoneCount::of_spectral(s);
-        preview
+        )
     }
 }
 
@@ -570,7 +559,24 @@ pub(super) fn record(
     regime: Regime,
     solved: Option<&SlipStep>,
 ) -> StepRecord {
-    let s = &driver.state;
+    record_of(
+        (step, t),
+        &driver.state,
+        (driver.phase, driver.displacement),
+        regime,
+        solved,
+    )
+}
+
+/// The record of state `s` at step `step` and time `t`, in phase `phase` with δ `displacement`,
+/// with zero increments.
+fn record_of(
+    (step, t): (usize, f64),
+    s: &ContactState,
+    (phase, displacement): (usize, f64),
+    regime: Regime,
+    solved: Option<&SlipStep>,
+) -> StepRecord {
     let (lo, hi) = s
         .traction
         .stick
@@ -583,7 +589,7 @@ pub(super) fn record(
         t,
         q: s.tangential_load,
         regime,
-        phase: driver.phase,
+        phase,
         half_width: s.half_width,
         eccentricity: -s.centre,
         stick_lo: lo,
@@ -594,7 +600,7 @@ pub(super) fn record(
         newton_iterations: solved.map_or(0, |x| x.newton_iterations),
         residual: solved.map_or(0.0, |x| x.residual),
         admissibility: solved.map_or_else(StepAdmissibility::default, |x| x.admissibility),
-        displacement: driver.displacement,
+        displacement,
         dissipation: 0.0,
         normal_work: 0.0,
         electric_work: 0.0,
