@@ -1,7 +1,9 @@
-//! One load step: the driver state that outlives a step ([`DriverState`]), and the step itself,
-//! solved by [`solve_slip`] from the committed state and memory, checked, and only then
-//! committed ([`solve_step`], then [`finish_step`] with the step's increments and record;
-//! [`advance`] does both). A new phase stores the memory of the current state.
+//! One load step: the driver state that outlives a step ([`DriverState`]), and the step itself:
+//! tried by [`try_step`] from the committed state and memory ([`solve_slip`] solves and checks
+//! it; the driver is left as it was), then committed by [`DriverState::commit`] (phase, memory,
+//! anchor, warm start, trace) and finished by [`finish_step`] with its increments and record
+//! ([`solve_step`] tries and commits, [`advance`] does all three). A new phase stores the
+//! memory of the turning state.
 
 use std::sync::{Arc, OnceLock};
 
