@@ -10,8 +10,10 @@
 //! `#[serde(with = "crate::shared")]` (or `crate::shared::option` for an `Option<Arc<T>>`).
 
 use std::any::TypeId;
+use std::cell::RefCell;
 use std::collections::HashMap;
 use std::sync::Arc;
+use std::thread::LocalKey;
 
 use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -23,36 +25,34 @@ use crate::cache::{SERDE_READ as READ, SERDE_WRITTEN as WRITTEN};
 /// Run `write` (a serialisation) with shared `Arc`s written once; inside another
 /// `write_shared`, as part of the outer one (its values are shared with the outer's).
 pub fn write_shared<R>(write: impl FnOnce() -> R) -> R {
-    if WRITTEN.with(|w| w.borrow().is_some()) {
-        return write();
-    }
-    WRITTEN.with(|w| *w.borrow_mut() = Some(HashMap::new()));
-    // Ended when dropped, also when `write` unwinds.
-    struct Scope;
-    impl Drop for Scope {
-        fn drop(&mut self) {
-            WRITTEN.with(|w| *w.borrow_mut() = None);
-        }
-    }
-    let _scope = Scope;
-    write()
+    in_scope(&WRITTEN, write)
 }
 
 /// Run `read` (a deserialisation) of what [`write_shared`] wrote; inside another
 /// `read_shared`, as part of the outer one.
 pub fn read_shared<R>(read: impl FnOnce() -> R) -> R {
-    if READ.with(|r| r.borrow().is_some()) {
-        return read();
+    in_scope(&READ, read)
+}
+
+/// Run `f` with the table `key` open: a new empty table unless one is open already (then `f`
+/// is part of the outer scope). The table is closed when the outermost scope ends, also when
+/// `f` unwinds.
+fn in_scope<K: 'static, V: 'static, R>(
+    key: &'static LocalKey<RefCell<Option<HashMap<K, V>>>>,
+    f: impl FnOnce() -> R,
+) -> R {
+    if key.with(|t| t.borrow().is_some()) {
+        return f();
     }
-    READ.with(|r| *r.borrow_mut() = Some(HashMap::new()));
-    struct Scope;
-    impl Drop for Scope {
+    key.with(|t| *t.borrow_mut() = Some(HashMap::new()));
+    struct Scope<K: 'static, V: 'static>(&'static LocalKey<RefCell<Option<HashMap<K, V>>>>);
+    impl<K: 'static, V: 'static> Drop for Scope<K, V> {
         fn drop(&mut self) {
-            READ.with(|r| *r.borrow_mut() = None);
+            self.0.with(|t| *t.borrow_mut() = None);
         }
     }
-    let _scope = Scope;
-    read()
+    let _scope = Scope(key);
+    f()
 }
 
 #[derive(Serialize)]
