@@ -19,7 +19,19 @@ pub struct Hertz {
 }
 
 impl Hertz {
-    /// For load P (N/m), radius R (m) and compliance Y* (1/Pa).
+    /// For load P (N/m), radius R (m) and compliance Y* (1/Pa): `a² = 2 P R Y*/π`,
+    /// `p0 = 2P/(πa)` (Johnson, *Contact Mechanics*, eqs. 4.43–4.45 with `Y* = 2/E*`).
+    ///
+    /// ```
+    /// use fretsim::analytical::Hertz;
+    /// use fretsim::material::ALUMINIUM;
+    ///
+    /// let e_star = ALUMINIUM.plane_strain_modulus();
+    /// let h = Hertz::new(2240.0, 0.01, 2.0 / e_star);
+    /// // ∫p dx = π a p0 / 2 = P
+    /// assert!((std::f64::consts::PI * h.half_width * h.peak_pressure / 2.0 - 2240.0).abs() < 1e-9);
+    /// assert!((h.pressure(0.0) - h.peak_pressure).abs() < 1e-6 && h.pressure(h.half_width) == 0.0);
+    /// ```
     pub fn new(normal_load: f64, radius: f64, compliance: f64) -> Self {
         let a = (2.0 * normal_load * radius * compliance / PI).sqrt();
         Self {

@@ -184,6 +184,17 @@ impl SurfaceCompliance {
     }
 
     /// The same coefficients in the seed paper's convention (Appendix A.2).
+    ///
+    /// ```
+    /// use fretsim::halfplane::SurfaceCompliance;
+    /// use fretsim::material::{Material, PZT4};
+    ///
+    /// let f = SurfaceCompliance::of(&Material::Piezoelectric(PZT4)).paper_coefficients().f;
+    /// // Table 1's constants give f11 = −7.5241e−12 i (1/Pa, as printed in A.2 to five
+    /// // digits); reciprocity gives f22 = −f11 (A.2 prints 7.4241e−12 i, a digit typo).
+    /// assert!((f[0][0].1 + 7.5241e-12).abs() < 5e-17 && f[0][0].0 == 0.0);
+    /// assert!((f[1][1].1 + f[0][0].1).abs() < 1e-20);
+    /// ```
     pub fn paper_coefficients(&self) -> PaperCoefficients {
         let e = self.electric.unwrap_or(ElectricCompliance {
             y23: 0.0,

@@ -26,9 +26,15 @@
 //! consistency conditions of bounded solutions ([`contact`]).
 //!
 //! ## Use as a library
+//! `use fretsim::prelude::*;` brings the names most programs need ([`prelude`]).
 //! [`scenario::parse`] and [`scenario::validate`] (or [`scenario::load`] for a file) give a
 //! [`scenario::Scenario`]; [`io::solve`] solves it and writes nothing; [`io::run()`] also
-//! writes the output folder that `fretsim run` writes.
+//! writes the output folder that `fretsim run` writes. The [`Solution`] holds the summary
+//! (everything of `summary.json`), the step records (Q, δ, the stick zone, the solver that
+//! took each step), the cycles and the sampled fields (p, q, g, σxx0, Dx0 at each snapshot);
+//! [`io::steps_table`], [`io::cycles_table`] and [`io::fields_table`] give them as the
+//! columns of the CSV files. An [`history::Observer`] passed to [`solve`] sees each step as
+//! it is accepted (with the contact state) and can stop the run.
 //!
 //! ```
 //! use fretsim::history::NoObserver;
@@ -58,22 +64,61 @@
 //! | d | datum distance of the regularised log kernel | m |
 //!
 //! ## Modules
-//! - [`material`]: constants, presets, validation.
-//! - [`halfplane`]: surface compliance (extended Stroh formalism), the paper's f_ij, Δ1…Δ4.
-//! - [`quadrature`]: Gauss–Chebyshev grids, factored collocation matrices, Chebyshev series;
-//!   [`transforms`]: the grids' cosine and sine sums by real FFTs.
-//! - [`contact`]: the contact model and state; [`contact::frictionless`] (Hertz, Zhou & Lee),
-//!   [`contact::normal`] (Spence's self-similar partial slip), [`contact::pressure`] (shared
-//!   pressure and charge sub-problems).
-//! - `cache`: the crate's only statics (tables keyed by size, each thread's scratch
-//!   buffers); the speed-ups that carry information from step to step are switched by
-//!   [`contact::tangential::Accelerations`].
-//! - [`analytical`]: closed-form oracles.
-//! - [`analysis`]: the cycles of a history, the energy per cycle and the verdict.
-//! - [`scenario`], [`io`], [`cli`], [`error`]: input, solving and writing a run or a sweep, arguments,
-//!   errors. The numerical modules do no I/O.
+//! The public ones (the library's interface):
+//! - [`scenario`]: the scenario (material, punch, friction, loads, numerics, output), its
+//!   parsing and validation; [`material`]: constants, presets, validation.
+//! - [`contact`]: the contact model ([`ContactModel`], [`Profile`], [`Electrode`]) and state;
+//!   [`contact::frictionless`] (Hertz, Zhou & Lee), [`contact::normal`] (Spence's
+//!   self-similar partial slip), [`contact::memory`] (the strain memory of the stick zones).
+//! - [`history`]: the load history and its driver ([`history::run_history`]), the step
+//!   records and the [`history::Observer`] of a run.
+//! - [`analysis`]: the cycles of a history, the energy per cycle and the verdict;
+//!   [`analytical`]: closed-form oracles; [`halfplane`]: the surface compliance (extended
+//!   Stroh formalism), the paper's f_ij, Δ1…Δ4.
+//! - [`io`]: solving a scenario and writing its output folder; [`cli`]: the command;
+//!   [`error`]: errors and their exit codes.
+//!
+//! Internal to the crate (public only under the `internals` feature, which the crate's own
+//! tests and benches enable; `cargo doc --document-private-items` documents them):
+//! `quadrature` (Gauss–Chebyshev grids, factored collocation matrices, Chebyshev series),
+//! `transforms` (the grids' cosine and sine sums by real FFTs), `contact::pressure` (the
+//! pressure and charge sub-problems), `contact::tangential` (the spectral slip solver of the
+//! paper; its speed-ups are switched by [`contact::Accelerations`]), `contact::general` (the
+//! element solver for any zone structure), the output writers under `io`, and `cache` (the
+//! crate's only statics: tables keyed by size, each thread's scratch buffers). The numerical
+//! modules do no I/O.
 #![warn(missing_docs)]
 #![deny(clippy::float_cmp)]
+// The documentation of public items names the internal functions that implement them; those
+// links resolve with `cargo doc --document-private-items`.
+#![allow(rustdoc::private_intra_doc_links)]
+
+/// Declares a module internal to the crate: `pub(crate)`, and public only under the
+/// `internals` feature, which the crate's own integration tests, benches and examples enable
+/// (no stable interface).
+macro_rules! internal {
+    ($(#[$attr:meta])* mod $name:ident;) => {
+        $(#[$attr])*
+        #[cfg(feature = "internals")]
+        pub mod $name;
+        $(#[$attr])*
+        #[cfg(not(feature = "internals"))]
+        pub(crate) mod $name;
+    };
+}
+
+/// Re-exports names of internal modules: `pub(crate)`, and public only under the `internals`
+/// feature.
+macro_rules! internal_use {
+    ($($tree:tt)*) => {
+        #[cfg(feature = "internals")]
+        pub use $($tree)*
+        #[cfg(not(feature = "internals"))]
+        #[allow(unused_imports)]
+        pub(crate) use $($tree)*
+
+    };
+}
 
 pub mod analysis;
 pub mod analytical;
@@ -85,10 +130,11 @@ pub mod halfplane;
 pub mod history;
 pub mod io;
 pub mod material;
-pub mod quadrature;
+pub mod prelude;
+internal! { mod quadrature; }
 pub mod scenario;
 mod shared;
-pub mod transforms;
+internal! { mod transforms; }
 
 // The entry points most programs need, at the crate root.
 pub use analysis::Verdict;

@@ -5,8 +5,7 @@
 use std::path::Path;
 
 use fretsim::error::Error;
-use fretsim::io::csv::{Column, Table, cycles_table, fields_table, steps_table};
-use fretsim::io::folder::{Protected, RunFolder};
+use fretsim::io::{Column, Table, cycles_table, fields_table, steps_table};
 use fretsim::scenario::{self, Scenario};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
@@ -149,11 +148,10 @@ fn solve_one(text: &str, label: &str, out: Option<&str>) -> Result<Outcome, Erro
         let solution = fretsim::io::solve(&scenario, &mut fretsim::history::NoObserver)?;
         return Ok(outcome(&scenario, &solution));
     };
-    let folder = RunFolder::claim(Path::new(out), &Protected::new(None))?;
     // As `fretsim run`: a failed normal loading leaves failure.json; a history that stops
     // part-way is written and returned with its failure.
     let result =
-        fretsim::io::run::run_partial(&scenario, folder, &mut fretsim::history::NoObserver)?;
+        fretsim::io::run_partial(&scenario, Path::new(out), &mut fretsim::history::NoObserver)?;
     Ok(outcome(&scenario, &result.solution))
 }
 

@@ -55,13 +55,13 @@
 //! valid on and off the contact (off it p = q = g = 0 and only the Cauchy terms remain).
 
 pub mod frictionless;
-pub mod general;
+internal! { mod general; }
 pub mod memory;
 pub mod normal;
-pub mod pressure;
-pub mod profile;
-pub mod roots;
-pub mod tangential;
+internal! { mod pressure; }
+internal! { mod profile; }
+internal! { mod roots; }
+internal! { mod tangential; }
 
 mod inherited;
 mod kinks;
@@ -76,19 +76,27 @@ use crate::error::MaterialFailure;
 use crate::halfplane::{SurfaceCompliance, SurfaceFieldCoefficients};
 use crate::material::Material;
 pub(crate) use inherited::smootherstep;
-pub use inherited::{Inherited, RememberedRoot};
-pub use kinks::{
-    Kink, Kinks, half_ellipse, half_ellipse_cauchy, half_ellipse_integral, kink_cauchy,
-    kink_density, kink_domain,
-};
+pub use pressure::Discretisation;
 pub use profile::Profile;
-pub use rules::{
-    GradedTable, field_rule_nodes, graded_cumulative, graded_nodes, graded_rule,
-    slip_check_rule_nodes, slip_zone_rule_nodes, slip_zone_smooth_nodes, step_breakpoints,
-};
 pub use state::{ContactState, Traction};
-pub use stick_zone::{StickZone, ZoneTables};
-pub use surface::{GapReport, SurfacePoint};
+pub use surface::SurfacePoint;
+pub use tangential::{Accelerations, SlipOptions};
+
+internal_use! { inherited::{Inherited, RememberedRoot}; }
+internal_use! {
+    kinks::{
+        Kink, Kinks, half_ellipse, half_ellipse_cauchy, half_ellipse_integral, kink_cauchy,
+        kink_density, kink_domain,
+    };
+}
+internal_use! {
+    rules::{
+        GradedTable, field_rule_nodes, graded_cumulative, graded_nodes, graded_rule,
+        slip_check_rule_nodes, slip_zone_rule_nodes, slip_zone_smooth_nodes, step_breakpoints,
+    };
+}
+internal_use! { stick_zone::{StickZone, ZoneTables}; }
+internal_use! { surface::GapReport; }
 
 /// How the punch is connected electrically (piezoelectric half-plane only).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

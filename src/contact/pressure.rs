@@ -98,8 +98,6 @@ pub struct PressureSolution {
     pub centre: f64,
     /// Pressure representation (Pa).
     pub pressure: BoundedSeries,
-    /// Fixed-point iterations used for (a, c).
-    pub iterations: usize,
 }
 
 /// Solve the pressure for the shear traction `q(x)` (material coordinates), starting from
@@ -134,7 +132,6 @@ pub fn solve_pressure(
             half_width: a,
             centre: 0.0,
             pressure,
-            iterations: 1,
         });
     }
     // G(a, c): the (a, c) that the consistency and resultant conditions give for the shear
@@ -160,7 +157,7 @@ pub fn solve_pressure(
     let mut jac = [[-1.0, 0.0], [0.0, -1.0]];
     let max_iter = 200;
     let mut last = f64::INFINITY;
-    for iter in 1..=max_iter {
+    for _ in 0..max_iter {
         let norm = f[0].hypot(f[1]);
         if !norm.is_finite() {
             return Err(SolveFailure::NonFinite {
@@ -180,7 +177,6 @@ pub fn solve_pressure(
                 half_width: a,
                 centre: c,
                 pressure: BoundedSeries::from_nodes(&disc.bounded, &psi),
-                iterations: iter,
             });
         }
         let det = jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0];

@@ -100,6 +100,7 @@ impl DriverState {
 
 /// Advance the driver by one load step: solve it ([`solve_step`]), compute its increments
 /// ([`StepIncrements::compute`]) and commit them ([`finish_step`]).
+#[cfg(any(test, feature = "internals"))]
 pub fn advance(
     model: &ContactModel,
     disc: &Discretisation,
@@ -121,6 +122,7 @@ pub fn advance(
 
 /// A solved step: a hold (nothing changes) or a slip step whose increments are still to be
 /// computed.
+#[cfg(any(test, feature = "internals"))]
 pub enum Solved {
     /// ΔQ = 0 (the regime is [`Regime::Stick`]).
     Hold(Regime),
@@ -196,6 +198,7 @@ pub fn finish_step(
 /// Solve one load step and commit its state to the driver (phase, memory, anchor, warm
 /// start): [`try_step`], then [`DriverState::commit`]; its increments are left to
 /// [`finish_step`].
+#[cfg(any(test, feature = "internals"))]
 pub fn solve_step(
     model: &ContactModel,
     disc: &Discretisation,

@@ -31,9 +31,9 @@
 //! A step's increments — Δδ at the anchor, the frictional dissipation and the works of P and
 //! of the electric load ([`StepIncrements`], [`step_dissipation`]) — need only the step's two
 //! states, and the next step needs none of them, so [`run_history`] computes them on a second
-//! thread while it solves the next step ([`solve_step`], then [`finish_step`] in order);
-//! [`continue_run`] does the same from any driver state, and [`advance`] does it
-//! sequentially. The records are the same either way.
+//! thread while it solves the next step ([`try_step`] and [`DriverState::commit`], then
+//! [`finish_step`] in order); [`continue_run`] does the same from any driver state, and the
+//! tests' `advance` does it sequentially. The records are the same either way.
 //!
 //! # Two solvers
 //! [`continue_run`] hands a step that the spectral solver cannot take (it fails, or could only
@@ -83,7 +83,7 @@
 //! [`Recalled::admissibility`]: crate::contact::tangential::Recalled::admissibility
 
 mod driver;
-pub mod general;
+internal! { mod general; }
 mod hints;
 mod increments;
 mod load;
@@ -92,18 +92,22 @@ mod regime;
 mod run;
 mod state;
 
-pub use driver::{
-    DriverState, Solved, SolvedStep, Trial, Tried, advance, finish_step, solve_step, try_step,
-};
-pub use general::{GeneralRun, GeneralRunData, RunOptions, SolverChoice, SolverKind, ZoneCount};
-pub use increments::{IncrementInputs, StepIncrements, step_dissipation};
+pub use general::{RunOptions, SolverChoice, SolverKind, ZoneCount};
 pub use load::{LoadHistory, LoadPoint};
-pub use record::{
-    NoObserver, Observer, SolvedState, SolvedStateData, StateView, StepFailure, StepRecord,
-};
-pub use regime::{PhaseEvent, Regime, next_regime, phase_event};
-pub use run::{HistoryFailure, HistoryRun, continue_run, run_from, run_history, turning_points};
-pub use state::{HistoryState, HistoryStateData, HistoryStateView};
+pub use record::{NoObserver, Observer, SolvedState, StateView, StepFailure, StepRecord};
+pub use regime::Regime;
+pub use run::{HistoryFailure, HistoryRun, run_history};
+pub use state::{HistoryState, HistoryStateView};
+
+internal_use! { driver::{DriverState, SolvedStep, Trial, Tried, finish_step, try_step}; }
+#[cfg(any(test, feature = "internals"))]
+pub use driver::{Solved, advance, solve_step};
+internal_use! { general::{GeneralRun, GeneralRunData}; }
+internal_use! { increments::{IncrementInputs, StepIncrements, step_dissipation}; }
+internal_use! { record::SolvedStateData; }
+internal_use! { regime::{PhaseEvent, next_regime, phase_event}; }
+internal_use! { run::{continue_run, run_from, turning_points}; }
+internal_use! { state::HistoryStateData; }
 
 #[cfg(test)]
 use crate::contact::pressure::Discretisation;

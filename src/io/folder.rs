@@ -401,11 +401,6 @@ impl RunFolder {
         allowed(target, protected, FolderKind::Run).map(|_| ())
     }
 
-    /// The folder the output will have once committed.
-    pub fn target(&self) -> &Path {
-        &self.target
-    }
-
     /// Write one file (relative, `/`-separated) into the staging folder.
     pub fn write(&mut self, relative: &str, bytes: &[u8]) -> Result<(), Error> {
         let path = self.staging.join(relative);

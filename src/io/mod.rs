@@ -1,29 +1,34 @@
 //! The input/output layer on top of the numerical core: solving a scenario and writing what a
 //! run and a sweep produce. The numerical modules (`halfplane`, `quadrature`, `contact`,
 //! `history`, `analysis`) do no I/O; everything that touches the file system is here, in
-//! `scenario` (reading) and in the command (`main.rs`).
+//! `scenario` (reading) and in the command ([`crate::cli`]).
 //!
-//! - [`mod@run`]: [`solve`] (a scenario's results, nothing written) and [`run()`] (solve, then write
-//!   the output folder);
-//! - [`summary`]: the contents of `summary.json`;
-//! - [`csv`], [`plots`], [`history_plots`], [`svg`]: the files of a run; [`png`]: the PNG
-//!   beside each SVG plot (resvg, embedded font);
-//! - [`mod@sweep`]: `fretsim sweep`, and its result plots and maps (`sweep_plots`);
-//! - [`checkpoint`]: the checkpoints a run writes as it goes, and resuming from one;
-//! - [`folder`]: the output folder's rules: never touch what fretsim did not write, replace a
-//!   previous output atomically.
+//! What a program calls: [`solve`] (a scenario's results, nothing written), [`run()`] (solve,
+//! then write the output folder that `fretsim run` writes) and [`run_partial`] (the same, with
+//! a failure part-way through the history kept beside what was written); the results are a
+//! [`Solution`] (with [`summary`], the contents of `summary.json`) and, as columns,
+//! [`steps_table`], [`cycles_table`] and [`fields_table`] (the CSV files' contents).
+//!
+//! Inside (crate-internal): `run` (the above), `csv`, `plots`, `history_plots`, `svg` (the
+//! files of a run), `png` (the PNG beside each SVG plot: resvg, embedded font), `sweep`
+//! (`fretsim sweep`, its result plots and maps in `sweep_plots`), `checkpoint` (the
+//! checkpoints a run writes as it goes, and resuming from one) and `folder` (the output
+//! folder's rules: never touch what fretsim did not write, replace a previous output
+//! atomically).
 
-pub mod checkpoint;
-pub mod csv;
-pub mod folder;
-pub mod history_plots;
-pub mod plots;
-pub mod png;
-pub mod run;
+internal! { mod checkpoint; }
+internal! { mod csv; }
+internal! { mod folder; }
+internal! { mod history_plots; }
+internal! { mod plots; }
+internal! { mod png; }
+internal! { mod run; }
 pub mod summary;
-pub mod svg;
-pub mod sweep;
+internal! { mod svg; }
+internal! { mod sweep; }
 mod sweep_plots;
 
-pub use run::{RunResult, Solution, run, run_resumed, run_with, solve};
-pub use sweep::{Shard, SweepOptions, SweepOutput, Vary, sweep};
+pub use self::csv::{Column, Table, cycles_table, fields_table, steps_table};
+pub(crate) use run::run_resumed;
+pub use run::{FieldSet, RunResult, Solution, run, run_partial, solve};
+pub(crate) use sweep::{Shard, SweepOptions, Vary, sweep};

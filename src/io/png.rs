@@ -116,6 +116,7 @@ fn crc32(bytes: &[u8]) -> u32 {
 }
 
 /// The width and height (px) of a PNG, from its header; `None` if it is not a PNG.
+#[cfg(any(test, feature = "internals"))]
 pub fn png_size(png: &[u8]) -> Option<(u32, u32)> {
     let header = png.get(..24)?;
     (&header[..8] == b"\x89PNG\r\n\x1a\n" && &header[12..16] == b"IHDR").then(|| {

@@ -68,8 +68,11 @@ pub fn field_points(centre: f64, half_width: f64, count: usize) -> Vec<f64> {
 /// Solve a validated scenario and write its outputs into `out_dir`, which must be new or a
 /// previous fretsim output ([`RunFolder::claim`]).
 pub fn run(scenario: &Scenario, out_dir: &Path) -> Result<RunResult, Error> {
-    let folder = RunFolder::claim(out_dir, &Protected::new(None))?;
-    run_with(scenario, folder, &mut crate::history::NoObserver)
+    let mut result = run_partial(scenario, out_dir, &mut crate::history::NoObserver)?;
+    match result.solution.failure.take() {
+        None => Ok(result),
+        Some(failure) => Err(failure),
+    }
 }
 
 /// Sampled surface fields of one instant: a field file and a curve of the plots.
@@ -179,32 +182,20 @@ impl crate::history::Observer for Snapshots<'_> {
     }
 }
 
-/// As [`run`], reporting each accepted step to `observer` (progress bars).
-pub fn run_with(
-    scenario: &Scenario,
-    folder: RunFolder,
-    observer: &mut dyn crate::history::Observer,
-) -> Result<RunResult, Error> {
-    let mut result = run_partial(scenario, folder, observer)?;
-    match result.solution.failure.take() {
-        None => Ok(result),
-        Some(failure) => Err(failure),
-    }
-}
-
-/// As [`run_with`], but a solver failure during the history stays in the result's
-/// [`Solution::failure`], beside what was written (the summary and the fields reached). A
-/// failure of the normal loading is returned as `Err` after `failure.json` is written; so is
-/// a write error.
+/// As [`run()`], but a solver failure during the history stays in the result's
+/// [`Solution::failure`], beside what was written (the summary and the fields reached); each
+/// accepted step is reported to `observer`. A failure of the normal loading is returned as
+/// `Err` after `failure.json` is written; so is a write error.
 pub fn run_partial(
     scenario: &Scenario,
-    folder: RunFolder,
+    out_dir: &Path,
     observer: &mut dyn crate::history::Observer,
 ) -> Result<RunResult, Error> {
+    let folder = RunFolder::claim(out_dir, &Protected::new(None))?;
     run_resumed(scenario, folder, None, observer)
 }
 
-/// As [`run_partial`], resuming from `resume` when given (a checkpoint that an interrupted
+/// As [`run_partial`] into a claimed folder, resuming from `resume` when given (a checkpoint that an interrupted
 /// run left in the folder, [`RunFolder::claim_resuming`] and
 /// [`crate::io::checkpoint::read_checkpoint`]). The run writes its checkpoints into the
 /// folder's staging folder as it goes ([`crate::io::checkpoint`]).

@@ -133,6 +133,7 @@ pub struct Figure<'a> {
 }
 
 /// A line plot as an SVG document ([`Figure`] with curves only).
+#[cfg(test)]
 pub fn line_plot(title: &str, x_label: &str, y_label: &str, series: &[Series<'_>]) -> String {
     Figure {
         title: title.into(),

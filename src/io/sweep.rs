@@ -9,7 +9,7 @@ use crate::contact::pressure::Discretisation;
 use crate::error::Error;
 use crate::io::folder::{Protected, RunFolder, SweepFolder};
 use crate::io::plots::{FamilyMember, PlotScales, family_plots, index_html};
-use crate::io::run::{FieldSet, run_partial};
+use crate::io::run::{FieldSet, run_resumed};
 use crate::io::summary::{NormalSummary, normal_summary};
 use crate::io::sweep_plots::{ResultColumn, sweep_plots};
 use crate::scenario::Scenario;
@@ -469,7 +469,7 @@ pub fn sweep(
             let outcome = if options.runs {
                 let dir = out_dir.join(variant_dir(*i));
                 let claimed = RunFolder::claim(&dir, protected);
-                match claimed.and_then(|f| run_partial(sc, f, &mut crate::history::NoObserver)) {
+                match claimed.and_then(|f| run_resumed(sc, f, None, &mut crate::history::NoObserver)) {
                     // A history that stops part-way keeps its normal loading and the fields
                     // reached.
                     Ok(r) => VariantOutcome {

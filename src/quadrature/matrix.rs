@@ -42,41 +42,21 @@ impl RowMatrix {
         &mut self.data[i * self.cols..(i + 1) * self.cols]
     }
 
-    /// `y = A x`.
-    pub fn apply(&self, x: &[f64], y: &mut [f64]) {
-        debug_assert_eq!(x.len(), self.cols);
-        self.products(x, Out::Set(y));
-    }
-
-    /// The products of the first rows with `x` (as many as `out` has entries) into `out`, in
-    /// one SIMD dispatch for all of them.
-    fn products(&self, x: &[f64], out: Out) {
-        let (Out::Set(y) | Out::Add(y, _)) = &out;
-        debug_assert!(
-            self.cols == 0 || y.len() <= self.rows(),
-            "more outputs than rows"
-        );
-        if self.cols == 0 {
-            if let Out::Set(y) = out {
-                y.fill(0.0);
-            }
+    /// `y += factor · A x` for the first rows (as many as `y` has entries), in one SIMD
+    /// dispatch for all of them; nothing for a matrix without rows (an absent map).
+    pub fn add_apply(&self, x: &[f64], factor: f64, y: &mut [f64]) {
+        if self.rows() == 0 || self.cols == 0 {
             return;
         }
+        debug_assert_eq!(x.len(), self.cols);
+        debug_assert!(y.len() <= self.rows(), "more outputs than rows");
         pulp::Arch::new().dispatch(Dots {
             rows: &self.data,
             cols: self.cols,
             x,
-            out,
+            y,
+            factor,
         });
-    }
-
-    /// `y += factor · A x`; nothing for a matrix without rows (an absent map).
-    pub fn add_apply(&self, x: &[f64], factor: f64, y: &mut [f64]) {
-        if self.rows() == 0 {
-            return;
-        }
-        debug_assert_eq!(x.len(), self.cols);
-        self.products(x, Out::Add(y, factor));
     }
 }
 
@@ -153,20 +133,15 @@ impl ColumnMatrix {
     }
 
     /// Column n (its `rows` entries).
+    #[cfg(test)]
     pub fn column(&self, n: usize) -> &[f64] {
         &self.data[n * self.stride..n * self.stride + self.rows]
     }
 
     /// `y = A x` (the first `y.len()` rows).
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
-        self.products(x, y, None);
-    }
-
-    /// `y += factor · A x`; nothing for a matrix without rows (an absent map).
-    pub fn add_apply(&self, x: &[f64], factor: f64, y: &mut [f64]) {
-        if self.rows > 0 {
-            self.products(x, y, Some(factor));
-        }
+        debug_assert!(y.len() <= self.rows);
+        self.with_sums([x], |sums| y.copy_from_slice(&sums[..y.len()]));
     }
 
     /// `y_k = A x_k` for both k (the first `y_k.len()` rows), reading the matrix once.
@@ -179,17 +154,6 @@ impl ColumnMatrix {
         });
     }
 
-    fn products(&self, x: &[f64], y: &mut [f64], factor: Option<f64>) {
-        debug_assert!(y.len() <= self.rows);
-        self.with_sums([x], |sums| match factor {
-            None => y.copy_from_slice(&sums[..y.len()]),
-            Some(f) => {
-                for (yi, s) in y.iter_mut().zip(sums.iter()) {
-                    *yi += f * s;
-                }
-            }
-        });
-    }
 
     /// `f` of the padded sums `A x_k`, one after the other a stride apart, in this thread's
     /// buffer ([`crate::cache::with_column_sums`]): the products run at every pass of the tangential solver's inner iteration,
@@ -295,7 +259,7 @@ fn fill_block<S: pulp::Simd, const B: usize>(
     }
 }
 
-/// The column sums of [`ColumnMatrix::products`] for K vectors at once, `sums_k = Σ_n x_{k,n}
+/// The column sums of [`ColumnMatrix::apply`] for K vectors at once, `sums_k = Σ_n x_{k,n}
 /// A[:, n]` (`sums` holds the K sums one after the other, a stride apart): each column is read
 /// once for all K, in blocks of `8/K` vectors of rows (8 accumulators), rows left over from the
 /// vectors one at a time. The products are bandwidth-bound (the matrix streams from the
@@ -430,21 +394,15 @@ fn simd_dot<S: pulp::Simd>(simd: S, a: &[f64], b: &[f64]) -> f64 {
     simd.reduce_sum_f64s(sum) + tail
 }
 
-/// Where [`Dots`] writes its row products.
-enum Out<'a> {
-    /// `y_i = row_i · x`.
-    Set(&'a mut [f64]),
-    /// `y_i += factor · row_i · x`.
-    Add(&'a mut [f64], f64),
-}
-
-/// The products of the rows of a row-major block (`cols` columns) with `x`, dispatched once
-/// for all rows ([`simd_dot`] inlined into the processor's SIMD instruction set).
+/// The products of the rows of a row-major block (`cols` columns) with `x`, added to `y`
+/// times `factor` (`y_i += factor · row_i · x`), dispatched once for all rows ([`simd_dot`]
+/// inlined into the processor's SIMD instruction set).
 struct Dots<'a> {
     rows: &'a [f64],
     cols: usize,
     x: &'a [f64],
-    out: Out<'a>,
+    y: &'a mut [f64],
+    factor: f64,
 }
 
 impl pulp::WithSimd for Dots<'_> {
@@ -452,19 +410,15 @@ impl pulp::WithSimd for Dots<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, simd: S) {
-        let Self { rows, cols, x, out } = self;
-        let rows = rows.chunks_exact(cols);
-        match out {
-            Out::Set(y) => {
-                for (yi, row) in y.iter_mut().zip(rows) {
-                    *yi = simd_dot(simd, row, x);
-                }
-            }
-            Out::Add(y, factor) => {
-                for (yi, row) in y.iter_mut().zip(rows) {
-                    *yi += factor * simd_dot(simd, row, x);
-                }
-            }
+        let Self {
+            rows,
+            cols,
+            x,
+            y,
+            factor,
+        } = self;
+        for (yi, row) in y.iter_mut().zip(rows.chunks_exact(cols)) {
+            *yi += factor * simd_dot(simd, row, x);
         }
     }
 }
@@ -490,8 +444,8 @@ mod tests {
                 }
             }
             let x: Vec<f64> = (0..cols).map(|j| value(50_000 + j)).collect();
-            let mut y = vec![f64::NAN; rows];
-            a.apply(&x, &mut y);
+            let mut y = vec![0.0; rows];
+            a.add_apply(&x, 1.0, &mut y);
             let mut z: Vec<f64> = (0..rows).map(|i| value(90_000 + i)).collect();
             let before = z.clone();
             a.add_apply(&x, 0.5, &mut z);
@@ -586,9 +540,6 @@ mod tests {
         a.apply_pair([&x, &x2], [&mut z1, &mut z2]);
         assert!(same(&y1, &z1) && same(&y2, &z2), "products of two vectors");
         a.clear();
-        let mut y = vec![1.5; 3];
-        a.add_apply(&x, 2.0, &mut y);
         assert_eq!(a.rows(), 0);
-        assert!(y.iter().all(|v| (v - 1.5).abs() <= 0.0));
     }
 }

@@ -47,10 +47,7 @@ mod series;
 pub use grid::{BoundedGrid, UnboundedGrid};
 pub use legendre::{gauss_legendre, gauss_legendre_cumulative};
 pub use matrix::{ColumnMatrix, RowMatrix, dot};
-pub use series::{
-    BoundedSeries, UnboundedSeries, chebyshev_t_sum, chebyshev_t_sums, chebyshev_u_sum,
-    chebyshev_u_sums,
-};
+pub use series::{BoundedSeries, UnboundedSeries, chebyshev_t_sum, chebyshev_t_sums};
 
 #[cfg(test)]
 mod tests {
@@ -64,6 +61,6 @@ mod tests {
     pub(super) fn u(n: usize, x: f64) -> f64 {
         let mut c = vec![0.0; n + 1];
         c[n] = 1.0;
-        chebyshev_u_sum(&c, x)
+        series::chebyshev_u_sum(&c, x)
     }
 }

@@ -169,6 +169,18 @@ pub const MAX_SNAPSHOTS: usize = 10_000;
 
 /// Check every rule; return all problems at once. Nothing whose size comes from the input
 /// (the repeated cycle, the load steps) is expanded before its size is checked.
+///
+/// Each issue names the field by its JSON path and states the rule:
+///
+/// ```
+/// use std::path::Path;
+///
+/// let text = fretsim::scenario::DEFAULT_SCENARIO.replace(r#""radius": 0.06"#, r#""radius": -1"#);
+/// let raw = fretsim::parse(&text, Path::new("example.json")).expect("well-formed JSON");
+/// let issues = fretsim::validate(raw).expect_err("a negative radius is invalid");
+/// assert_eq!(issues[0].path, "punch.radius");
+/// println!("{}", issues[0]); // `punch.radius` = … (the rule it breaks)
+/// ```
 pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
     let mut issues = Vec::new();
     validate_name(&mut issues, &raw.name);

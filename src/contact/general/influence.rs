@@ -19,19 +19,9 @@ pub fn log_pair(x1: f64, x2: f64, s1: f64, s2: f64, d: f64) -> f64 {
     g2(x2 - s1, d) - g2(x1 - s1, d) - g2(x2 - s2, d) + g2(x1 - s2, d)
 }
 
-/// `∫_{x1}^{x2} ∫_{s1}^{s2} sign(x − s) ds dx` for elements `i` (field) and `j` (source) of a
-/// mesh: `±Δi Δj` for distinct elements, 0 for the same element.
-pub fn sign_pair(i: usize, j: usize, wi: f64, wj: f64) -> f64 {
-    match i.cmp(&j) {
-        std::cmp::Ordering::Greater => wi * wj,
-        std::cmp::Ordering::Less => -wi * wj,
-        std::cmp::Ordering::Equal => 0.0,
-    }
-}
-
 /// The Galerkin matrices of a mesh: `log[i, j] = ∫_{e_i}∫_{e_j} ln(|x − s|/d)` (symmetric),
-/// stored, and `sign[i, j] = ∫_{e_i}∫_{e_j} sign(x − s)` (antisymmetric), applied in O(N) by
-/// [`sign_pair`]'s structure.
+/// stored, and `sign[i, j] = ∫_{e_i}∫_{e_j} sign(x − s)` (antisymmetric: `±Δi Δj` for
+/// distinct elements, 0 on the diagonal), applied in O(N) by its structure.
 #[derive(Debug, Clone)]
 pub struct Influence {
     /// The logarithmic kernel (m²).
@@ -86,14 +76,19 @@ pub(super) fn mat_vec(a: &Mat<f64>, v: &[f64], out: &mut [f64]) {
     );
 }
 
-/// `Σ a_i b_i`.
-pub fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(a, b)| a * b).sum()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+/// `∫_{x1}^{x2} ∫_{s1}^{s2} sign(x − s) ds dx` for elements `i` (field) and `j` (source) of a
+/// mesh: `±Δi Δj` for distinct elements, 0 for the same element.
+fn sign_pair(i: usize, j: usize, wi: f64, wj: f64) -> f64 {
+    match i.cmp(&j) {
+        std::cmp::Ordering::Greater => wi * wj,
+        std::cmp::Ordering::Less => -wi * wj,
+        std::cmp::Ordering::Equal => 0.0,
+    }
+}
 
     /// The O(N) sign product against the matrix of [`sign_pair`].
     #[test]

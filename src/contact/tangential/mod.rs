@@ -157,6 +157,7 @@ mod reuse;
 mod search;
 
 pub use accelerations::Accelerations;
+#[cfg(feature = "internals")]
 pub use checks::assess_step;
 pub(crate) use inner::InnerMaps;
 pub use search::solve_slip;
