@@ -29,7 +29,7 @@ use std::sync::Arc;
 use serde::{Deserialize, Serialize};
 
 use crate::contact::general::{
-    ElementState, Focus, GeneralState, Loads, Mesh, Options, Solver, StepReport,
+    ElementState, Focus, GeneralState, Loads, Mesh, Options, Recall, Solver, StepReport,
 };
 use crate::contact::tangential::{SlipOptions, StepAdmissibility};
 use crate::contact::{ContactModel, ContactState, Electrode};
@@ -302,10 +302,16 @@ pub fn mesh_for(state: &ContactState, inner: f64) -> Mesh {
 }
 
 impl GeneralRun {
-    /// Take over from the driver's committed state, on elements of at most `inner`·a.
-    pub fn handover(model: &ContactModel, driver: &DriverState, inner: f64) -> Self {
+    /// Take over from the driver's committed state, on elements of at most `inner`·a (the
+    /// solver from `recall`).
+    pub fn handover(
+        model: &ContactModel,
+        driver: &DriverState,
+        inner: f64,
+        recall: &mut Recall,
+    ) -> Self {
         let s = &driver.state;
-        let solver = Arc::new(Solver::new(model, mesh_for(s, inner), Options::default()));
+        let solver = recall.solver(model, mesh_for(s, inner), Options::default());
         let loads = loads_of(model, s.normal_load, s.tangential_load);
         let state = solver.adopt(s, loads, 0.0);
         Self {
@@ -368,11 +374,12 @@ impl GeneralRun {
         self.offset + self.state.shift
     }
 
-    /// Take one load step and commit it; its record.
+    /// Take one load step and commit it (through `recall`); its record.
     pub fn step(
         &mut self,
         model: &ContactModel,
         point: LoadPoint,
+        recall: &mut Recall,
     ) -> Result<StepRecord, StepFailure> {
         let LoadPoint { step, t, q } = point;
         let old = &self.state;
@@ -387,9 +394,8 @@ impl GeneralRun {
             tangential: q,
             ..old.loads
         };
-        let (new, report) = self
-            .solver
-            .step(old, loads)
+        let (new, report) = recall
+            .step(&self.solver, old, loads)
             .map_err(|failure| StepFailure {
                 step,
                 t,

@@ -4,6 +4,7 @@
 //! ([`HistoryFailure`]).
 
 use crate::contact::ContactModel;
+use crate::contact::general::Recall;
 use crate::contact::normal::NormalLoading;
 use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
@@ -129,12 +130,14 @@ pub fn continue_run(
 ) -> Option<StepFailure> {
     let turning = turning_points(current_load(state), points);
     let mut next = 0;
+    let mut recall = Recall::new(options.slip.accelerations.general_recall);
     if options.solver == SolverChoice::General && state.general.is_none() {
         let driver = &state.driver;
         state.general = Some(GeneralRun::handover(
             model,
             driver,
             options.general_element_size,
+            &mut recall,
         ));
     }
     while next < points.len() {
@@ -142,7 +145,7 @@ pub fn continue_run(
         let driver = &mut state.driver;
         let (mut run, step) = match state.general.take() {
             Some(mut run) => {
-                let step = run.step(model, point);
+                let step = run.step(model, point, &mut recall);
                 (run, step)
             }
             None => {
@@ -152,7 +155,7 @@ pub fn continue_run(
                     driver,
                     (&points[next..], &turning[next..]),
                     options,
-                    observer,
+                    (observer, &mut recall),
                     records,
                 )?;
                 next += stop.at;
@@ -163,9 +166,13 @@ pub fn continue_run(
                 match stop.taken {
                     Some((run, record)) => (run, Ok(record)),
                     None => {
-                        let mut run =
-                            GeneralRun::handover(model, driver, options.general_element_size);
-                        let step = run.step(model, points[next]);
+                        let mut run = GeneralRun::handover(
+                            model,
+                            driver,
+                            options.general_element_size,
+                            &mut recall,
+                        );
+                        let step = run.step(model, points[next], &mut recall);
                         (run, step)
                     }
                 }
@@ -293,7 +300,7 @@ fn spectral_stretch(
     driver: &mut DriverState,
     (points, turning): (&[LoadPoint], &[bool]),
     options: RunOptions,
-    observer: &mut dyn Observer,
+    (observer, recall): (&mut dyn Observer, &mut Recall),
     records: &mut Vec<StepRecord>,
 ) -> Option<Stop> {
     std::thread::scope(|scope| {
@@ -333,8 +340,13 @@ fn spectral_stretch(
             let tried = try_step(model, disc, driver, point, options.slip);
             finish(pending.take(), driver, records, observer);
             if let (true, Ok(Tried::Slip(trial))) = (check, &tried)
-                && let Some((failure, taken)) =
-                    contradicted(model, driver, (point, options), &trial.record(driver))
+                && let Some((failure, taken)) = contradicted(
+                    model,
+                    driver,
+                    (point, options),
+                    &trial.record(driver),
+                    recall,
+                )
             {
                 return Some(Stop {
                     at: k,
@@ -410,9 +422,10 @@ fn contradicted(
     before: &DriverState,
     (point, options): (LoadPoint, RunOptions),
     spectral: &StepRecord,
+    recall: &mut Recall,
 ) -> Option<(StepFailure, (GeneralRun, StepRecord))> {
-    let mut run = GeneralRun::handover(model, before, options.general_element_size);
-    let general = run.step(model, point).ok()?;
+    let mut run = GeneralRun::handover(model, before, options.general_element_size, recall);
+    let general = run.step(model, point, recall).ok()?;
     if agrees(&run, &general, spectral) {
         return None;
     }

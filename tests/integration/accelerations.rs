@@ -181,6 +181,8 @@ fn the_default_options_are_the_fast_path() {
             || none.fade_table_reuse
             || none.lent_maps
             || none.chain_tables
-            || none.exterior_tables)
+            || none.exterior_tables
+            || none.continuation
+            || none.general_recall)
     );
 }

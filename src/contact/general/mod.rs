@@ -115,6 +115,7 @@ pub mod mesh;
 mod dense;
 mod handover;
 mod normal;
+mod recall;
 mod tangential;
 
 #[cfg(test)]
@@ -130,6 +131,7 @@ use crate::error::SolveFailure;
 use dense::Workspace;
 use influence::Influence;
 pub use mesh::{Focus, Mesh};
+pub use recall::Recall;
 use normal::{NormalInput, NormalSolution};
 use tangential::{Bound, Programme};
 

@@ -1,5 +1,6 @@
 //! The switches of everything that carries information from one evaluation or step to the
-//! next only to go faster ([`Accelerations`]). With all of them off ([`Accelerations::none`],
+//! next only to go faster ([`Accelerations`]): the spectral tangential solver's, and the
+//! general solver's recall of repeated steps. With all of them off ([`Accelerations::none`],
 //! the reference path) each step is solved from the previous state, the memory and the load
 //! alone, with every table of the chain evaluated directly. The fast path reaches the same
 //! states to the solver's tolerance, or bit for bit where a switch says so; the integration
@@ -10,7 +11,7 @@
 
 use serde::Serialize;
 
-/// Which speed-ups of the spectral tangential solver are on (each `true` in [`Default`]).
+/// Which speed-ups are on (each `true` in [`Default`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Accelerations {
     /// Start a step from the same step of the last phase in the same direction that began
@@ -67,6 +68,12 @@ pub struct Accelerations {
     /// off, from the Mindlin–Deresiewicz guess and the previous state's contact. The states
     /// are the same to the tolerance.
     pub continuation: bool,
+    /// Let the general solver's steps reuse the solver of a mesh built again and the result
+    /// of a step that begins from a state equal to the bit to a remembered one's under the
+    /// same loads ([`crate::contact::general::Recall`]: the end-layer steps that begin every
+    /// phase of a steady cycle). Bit-identical: a step is a pure function of its solver, its
+    /// state and its loads.
+    pub general_recall: bool,
 }
 
 impl Default for Accelerations {
@@ -82,6 +89,7 @@ impl Default for Accelerations {
             chain_tables: true,
             exterior_tables: true,
             continuation: true,
+            general_recall: true,
         }
     }
 }
@@ -99,6 +107,7 @@ impl Accelerations {
             chain_tables: false,
             exterior_tables: false,
             continuation: false,
+            general_recall: false,
         }
     }
 
