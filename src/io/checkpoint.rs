@@ -25,7 +25,7 @@ use crate::error::Error;
 use crate::history::{
     HistoryState, HistoryStateData, HistoryStateView, SolvedState, SolvedStateData, StepRecord,
 };
-use crate::io::summary::Handover;
+use crate::io::summary::HandoverLog;
 use crate::scenario::Scenario;
 
 /// The states a run keeps for its field files and the handovers so far (see
@@ -42,7 +42,7 @@ pub(crate) struct Kept<S = SolvedState> {
     /// The last step at each snapshot time.
     pub(crate) at_times: Vec<Option<(StepRecord, S)>>,
     /// The steps handed to the general solver.
-    pub(crate) handovers: Vec<Handover>,
+    pub(crate) handovers: HandoverLog,
 }
 
 impl Kept<SolvedStateData> {

@@ -20,7 +20,7 @@ use crate::io::plots::{
 };
 use crate::io::png::plot_files;
 use crate::io::summary::{
-    Handover, Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary,
+    Handover, HandoverLog, Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary,
     solver_statistics,
 };
 use crate::scenario::{Scenario, TurningFields};
@@ -264,7 +264,7 @@ pub(crate) fn solve_from<'a>(
                 turning: Vec::new(),
                 last: Vec::new(),
                 at_times: vec![None; scenario.snapshots.len()],
-                handovers: Vec::new(),
+                handovers: HandoverLog::default(),
             },
             None,
         ),

@@ -1,6 +1,8 @@
 //! `summary.json`: the derived constants, the normal-loading state, the history's results and
 //! the solver's work counters, as serialisable data.
 
+use std::collections::{BTreeMap, VecDeque};
+
 use serde::Serialize;
 
 use crate::analysis::{CycleRow, Verdict};
@@ -130,12 +132,17 @@ pub struct HistorySummary {
     pub steps: usize,
     /// Number of phases (monotonic segments between reversals).
     pub phases: usize,
-    /// The states at the end of each phase: step, Q, stick ends, eccentricity.
+    /// The states at the end of each phase (step, Q, stick ends, eccentricity): the first
+    /// and the last [`LISTED`] of them (all of them in a run of at most 2·`LISTED`).
     pub turning_points: Vec<crate::history::StepRecord>,
+    /// How many turning points the history has.
+    pub turning_point_count: usize,
     /// The failure, if the run stopped early.
     pub failure: Option<String>,
-    /// Per-cycle table.
+    /// The cycles: the first and the last [`LISTED`] (`cycles.csv` has every one).
     pub cycles: Vec<CycleRow>,
+    /// How many cycles the history has.
+    pub cycle_count: usize,
     /// Shakedown verdict.
     pub verdict: Verdict,
     /// Tolerance of the verdict (relative).
@@ -171,13 +178,97 @@ pub struct SolverStatistics {
     pub max_residual: Option<f64>,
     /// Steps taken by the general element solver (`solver` in `steps.csv`).
     pub general_steps: usize,
-    /// Each step at which the general solver took over, with the reason the spectral solver
-    /// could not take it.
+    /// The steps at which the general solver took over, with the reason the spectral solver
+    /// could not take each: the first and the last [`LISTED`].
     pub handovers: Vec<Handover>,
+    /// How many times the general solver took over.
+    pub handover_count: usize,
+    /// How many handovers each kind of reason caused (the reason with its numbers written
+    /// `#`; at most [`REASON_KINDS`] kinds, the rest counted under `other`).
+    pub handover_reasons: BTreeMap<String, usize>,
     /// Worst `stick_excess` of a step (≤ 0 when admissible).
     pub worst_stick_excess: Option<f64>,
     /// Worst `slip_reversal` of a step (≤ 0 when admissible).
     pub worst_slip_reversal: Option<f64>,
+}
+
+/// How many items of a list that grows with the history (turning points, cycles, handovers)
+/// `summary.json` lists at its start and at its end: a long history's summary stays a
+/// summary (`steps.csv` and `cycles.csv` have every step and cycle).
+pub const LISTED: usize = 25;
+
+/// Kinds of handover reason counted apart in [`SolverStatistics::handover_reasons`].
+pub const REASON_KINDS: usize = 32;
+
+/// The first and the last [`LISTED`] items of `items`, in order.
+fn first_and_last<T: Clone>(items: &[T]) -> Vec<T> {
+    if items.len() <= 2 * LISTED {
+        return items.to_vec();
+    }
+    items[..LISTED]
+        .iter()
+        .chain(&items[items.len() - LISTED..])
+        .cloned()
+        .collect()
+}
+
+/// The handovers of a run as it goes: how many, how many of each kind of reason, and the first
+/// and the last [`LISTED`] in full. Its size does not grow with the history (it is written into
+/// every checkpoint).
+#[derive(Debug, Clone, Default, Serialize, serde::Deserialize)]
+pub struct HandoverLog {
+    count: usize,
+    reasons: BTreeMap<String, usize>,
+    first: Vec<Handover>,
+    last: VecDeque<Handover>,
+}
+
+impl HandoverLog {
+    /// Log a handover.
+    pub fn push(&mut self, handover: Handover) {
+        self.count += 1;
+        let kind = reason_kind(&handover.reason);
+        let key = if self.reasons.contains_key(&kind) || self.reasons.len() < REASON_KINDS {
+            kind
+        } else {
+            "other".to_string()
+        };
+        *self.reasons.entry(key).or_insert(0) += 1;
+        if self.first.len() < LISTED {
+            self.first.push(handover);
+        } else {
+            if self.last.len() == LISTED {
+                self.last.pop_front();
+            }
+            self.last.push_back(handover);
+        }
+    }
+}
+
+/// A reason with each number (a run of digits, signs, points and exponent letters holding a
+/// digit) written `#`: "finds 2 stick and 3 slip zones" → "finds # stick and # slip zones".
+fn reason_kind(reason: &str) -> String {
+    let numeric = |c: char| c.is_ascii_digit() || matches!(c, '.' | 'e' | 'E' | '+' | '-');
+    let mut out = String::with_capacity(reason.len());
+    let mut run = String::new();
+    let flush = |run: &mut String, out: &mut String| {
+        if run.chars().any(|c| c.is_ascii_digit()) {
+            out.push('#');
+        } else {
+            out.push_str(run);
+        }
+        run.clear();
+    };
+    for c in reason.chars() {
+        if numeric(c) {
+            run.push(c);
+        } else {
+            flush(&mut run, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut run, &mut out);
+    out
 }
 
 /// A step that the spectral solver could not take, taken by the general solver.
@@ -226,7 +317,7 @@ pub(crate) fn solver_statistics(
     scenario: &Scenario,
     normal: &NormalLoading,
     records: &[crate::history::StepRecord],
-    handovers: Vec<Handover>,
+    handovers: HandoverLog,
 ) -> SolverStatistics {
     let steps = records.iter().skip(1);
     let max = |f: &dyn Fn(&crate::history::StepRecord) -> f64| {
@@ -255,7 +346,9 @@ pub(crate) fn solver_statistics(
             .iter()
             .filter(|r| r.solver == SolverKind::General)
             .count(),
-        handovers,
+        handovers: handovers.first.into_iter().chain(handovers.last).collect(),
+        handover_count: handovers.count,
+        handover_reasons: handovers.reasons,
         worst_stick_excess: max(&|r| r.admissibility.stick_excess),
         worst_slip_reversal: max(&|r| r.admissibility.slip_reversal),
     }
@@ -271,19 +364,89 @@ pub(crate) fn history_summary(
     verdict: Verdict,
     tolerance: f64,
 ) -> HistorySummary {
-    let turning_points = records
+    let turning_points: Vec<&crate::history::StepRecord> = records
         .windows(2)
         .filter(|w| w[0].phase != w[1].phase && w[0].phase > 0)
-        .map(|w| w[0].clone())
-        .chain(records.last().filter(|r| r.phase > 0).cloned())
+        .map(|w| &w[0])
+        .chain(records.last().filter(|r| r.phase > 0))
         .collect();
     HistorySummary {
         steps: records.len().saturating_sub(1),
         phases: records.last().map_or(0, |r| r.phase),
-        turning_points,
+        turning_points: first_and_last(&turning_points)
+            .into_iter()
+            .cloned()
+            .collect(),
+        turning_point_count: turning_points.len(),
         failure: failure.map(|e| e.to_string()),
-        cycles: cycles.to_vec(),
+        cycles: first_and_last(cycles),
+        cycle_count: cycles.len(),
         verdict,
         verdict_tolerance: tolerance,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn handover(step: usize, reason: &str) -> Handover {
+        Handover {
+            step,
+            t: step as f64,
+            q: 0.0,
+            reason: reason.to_string(),
+        }
+    }
+
+    /// A reason's kind writes its numbers `#` and keeps its words.
+    #[test]
+    fn a_reason_kind_writes_the_numbers_as_hashes() {
+        assert_eq!(
+            reason_kind(
+                "the general solver finds 2 stick and 3 slip zones (1 slip sign changes) where \
+                 the spectral solver's state has 1 and 2"
+            ),
+            "the general solver finds # stick and # slip zones (# slip sign changes) where \
+             the spectral solver's state has # and #"
+        );
+        assert_eq!(
+            reason_kind("worst violation 1.041e1 at x = -4.536959e-5 m; the end"),
+            "worst violation # at x = # m; the end"
+        );
+    }
+
+    /// The log of 2·LISTED + 5 handovers keeps the count, the first and the last LISTED,
+    /// and the reasons' counts; beyond `REASON_KINDS` kinds the rest go under `other`.
+    #[test]
+    fn the_handover_log_keeps_the_first_and_the_last_and_counts_the_rest() {
+        let mut log = HandoverLog::default();
+        let n = 2 * LISTED + 5;
+        for step in 0..n {
+            log.push(handover(step, &format!("residual {step}e-3 stalled")));
+        }
+        assert_eq!(log.count, n);
+        let listed: Vec<usize> = log.first.iter().chain(&log.last).map(|h| h.step).collect();
+        assert_eq!(listed, (0..LISTED).chain(n - LISTED..n).collect::<Vec<_>>());
+        assert_eq!(log.reasons.len(), 1);
+        assert_eq!(log.reasons["residual # stalled"], n);
+        for k in 0..2 * REASON_KINDS {
+            log.push(handover(1000, &"x".repeat(k + 1)));
+        }
+        assert_eq!(log.reasons.len(), REASON_KINDS + 1);
+        assert_eq!(log.reasons["other"], REASON_KINDS + 1);
+        assert_eq!(log.count, n + 2 * REASON_KINDS);
+    }
+
+    /// Lists of at most 2·LISTED items are kept whole; longer ones lose their middle.
+    #[test]
+    fn first_and_last_keep_short_lists_whole() {
+        let short: Vec<usize> = (0..2 * LISTED).collect();
+        assert_eq!(first_and_last(&short), short);
+        let long: Vec<usize> = (0..3 * LISTED).collect();
+        let kept = first_and_last(&long);
+        assert_eq!(kept.len(), 2 * LISTED);
+        assert_eq!(kept[LISTED - 1], LISTED - 1);
+        assert_eq!(kept[LISTED], 2 * LISTED);
     }
 }

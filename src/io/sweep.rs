@@ -411,7 +411,7 @@ impl HistoryColumns {
             .unwrap_or_default();
         Some(Self {
             steps: h.steps,
-            cycles: h.cycles.len(),
+            cycles: h.cycle_count,
             verdict,
             friction_work: last.map_or(f64::NAN, |c| c.friction_work),
             displacement_amplitude: last.map_or(f64::NAN, |c| {

@@ -23,9 +23,9 @@ use super::{GeneralState, Loads, Mesh, Options, Solver, StepReport};
 use crate::contact::ContactModel;
 use crate::error::SolveFailure;
 
-/// Solvers kept: the meshes of the two phase starts of a cycle, with room for a block of a
-/// variable-amplitude history.
-const SOLVERS: usize = 8;
+/// Solvers kept: the meshes of the two phase starts of a cycle, twice (each holds two dense
+/// matrices of its elements: about 5 MB at 550 elements).
+const SOLVERS: usize = 4;
 /// Steps kept.
 const STEPS: usize = 32;
 
