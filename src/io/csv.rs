@@ -61,14 +61,40 @@ impl Table {
     /// The table as CSV with a header line.
     pub fn csv(&self) -> Vec<u8> {
         let mut w = csv::Writer::from_writer(Vec::new());
-        w.write_record(self.columns.iter().map(|(name, _)| *name))
-            .expect("in-memory write");
-        for row in 0..self.rows() {
-            w.write_record(self.columns.iter().map(|(_, c)| c.cell(row)))
-                .expect("in-memory write");
-        }
+        self.write_header(&mut w).expect("in-memory write");
+        self.write_rows(&mut w).expect("in-memory write");
         w.into_inner().expect("in-memory write")
     }
+
+    fn write_header<W: std::io::Write>(&self, w: &mut csv::Writer<W>) -> csv::Result<()> {
+        w.write_record(self.columns.iter().map(|(name, _)| *name))
+    }
+
+    fn write_rows<W: std::io::Write>(&self, w: &mut csv::Writer<W>) -> csv::Result<()> {
+        for row in 0..self.rows() {
+            w.write_record(self.columns.iter().map(|(_, c)| c.cell(row)))?;
+        }
+        Ok(())
+    }
+}
+
+/// Records per block of [`write_steps_csv`].
+const STEPS_BLOCK: usize = 4096;
+
+/// `steps.csv` written to `out` a block of records at a time (the same bytes as
+/// [`steps_table`]`(records, limit).csv()`, without holding the whole table: a long history
+/// has hundreds of thousands of steps).
+pub(crate) fn write_steps_csv(
+    records: &[StepRecord],
+    limit: f64,
+    out: &mut dyn std::io::Write,
+) -> std::io::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    steps_table(&[], limit).write_header(&mut w)?;
+    for block in records.chunks(STEPS_BLOCK) {
+        steps_table(block, limit).write_rows(&mut w)?;
+    }
+    w.flush()
 }
 
 fn real<T>(items: &[T], f: impl Fn(&T) -> f64) -> Column {
@@ -181,5 +207,30 @@ pub fn steps_table(records: &[StepRecord], limit: f64) -> Table {
                 Column::Count(r.iter().map(|r| r.zones.sign_changes).collect()),
             ),
         ],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `steps.csv` written in blocks has the bytes of the whole table's CSV, over more records
+    /// than a block (the default run's records repeated to 80 times their number).
+    #[test]
+    fn steps_written_in_blocks_are_the_whole_tables_bytes() {
+        let scenario = crate::scenario::default_scenario();
+        let solution = crate::io::solve(&scenario, &mut crate::history::NoObserver).unwrap();
+        let n = solution.records.len();
+        let records: Vec<StepRecord> = (0..80 * n)
+            .map(|k| StepRecord {
+                step: k,
+                ..solution.records[k % n].clone()
+            })
+            .collect();
+        assert!(records.len() > 2 * STEPS_BLOCK);
+        let limit = scenario.model.friction * scenario.normal_load;
+        let mut streamed = Vec::new();
+        write_steps_csv(&records, limit, &mut streamed).unwrap();
+        assert!(streamed == steps_table(&records, limit).csv());
     }
 }

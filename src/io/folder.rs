@@ -413,6 +413,26 @@ impl RunFolder {
         Ok(())
     }
 
+    /// Write one file (relative, `/`-separated) into the staging folder through a buffered
+    /// writer that `write` fills.
+    pub fn write_with(
+        &mut self,
+        relative: &str,
+        write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+    ) -> Result<(), Error> {
+        let path = self.staging.join(relative);
+        if let Some(parent) = path.parent() {
+            fs::create_dir_all(parent).map_err(write_err(parent))?;
+        }
+        let file = fs::File::create(&path).map_err(write_err(&path))?;
+        let mut buffered = std::io::BufWriter::new(file);
+        write(&mut buffered)
+            .and_then(|()| buffered.flush())
+            .map_err(write_err(&path))?;
+        self.files.push(relative.to_string());
+        Ok(())
+    }
+
     /// Save a checkpoint in the staging folder (`checkpoint/`, [`super::checkpoint`]):
     /// append `records` to `records.jsonl`, then replace `state.json` by `state` (written
     /// aside and renamed, so that it is always whole).

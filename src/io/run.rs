@@ -12,7 +12,7 @@ use crate::error::Error;
 use crate::history::HistoryStateView;
 use crate::history::{RunOptions, SolvedState, SolverKind, StateView, StepRecord};
 use crate::io::checkpoint::{CheckpointSink, Kept, Resume, write_records, write_state};
-use crate::io::csv::{cycles_table, fields_table, steps_table};
+use crate::io::csv::{cycles_table, fields_table, write_steps_csv};
 use crate::io::folder::{Protected, RunFolder};
 use crate::io::history_plots::history_plots;
 use crate::io::plots::{
@@ -510,16 +510,16 @@ pub(crate) fn write_solution(
     let limit = scenario.model.friction * scenario.normal_load;
     let scales = plot_scales(scenario, summary);
     let mut sections = Vec::new();
+    folder.write(
+        "summary.json",
+        &serde_json::to_vec_pretty(summary).expect("summary serialises"),
+    )?;
+    if scenario.history.is_some() {
+        folder.write_with("steps.csv", |w| write_steps_csv(records, limit, w))?;
+        folder.write("cycles.csv", &cycles_table(cycles).csv())?;
+    }
     {
         let mut put = |name: String, bytes: &[u8]| folder.write(&name, bytes);
-        put(
-            "summary.json".into(),
-            &serde_json::to_vec_pretty(summary).expect("summary serialises"),
-        )?;
-        if scenario.history.is_some() {
-            put("steps.csv".into(), &steps_table(records, limit).csv())?;
-            put("cycles.csv".into(), &cycles_table(cycles).csv())?;
-        }
         for set in fields.iter().chain(turning_fields) {
             put(
                 format!("fields/{}.csv", set.stem),
