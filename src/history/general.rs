@@ -313,7 +313,11 @@ impl GeneralRun {
         let s = &driver.state;
         let solver = recall.solver(model, mesh_for(s, inner), Options::default());
         let loads = loads_of(model, s.normal_load, s.tangential_load);
-        let state = solver.adopt(s, loads, 0.0);
+        let state = if recall.enabled() {
+            solver.adopt_rounded(s, loads, 0.0)
+        } else {
+            solver.adopt(s, loads, 0.0)
+        };
         Self {
             solver,
             state,

@@ -102,8 +102,10 @@ struct History {
     steps: usize,
     phases: usize,
     turning_points: Vec<serde_json::Value>,
+    turning_point_count: usize,
     failure: Option<String>,
     cycles: Vec<Cycle>,
+    cycle_count: usize,
     verdict: Verdict,
     verdict_tolerance: f64,
 }
@@ -139,6 +141,8 @@ struct Solver {
     max_residual: Option<f64>,
     general_steps: usize,
     handovers: Vec<serde_json::Value>,
+    handover_count: usize,
+    handover_reasons: std::collections::BTreeMap<String, usize>,
     worst_stick_excess: Option<f64>,
     worst_slip_reversal: Option<f64>,
 }
@@ -339,7 +343,8 @@ fn run_checked(scenario: &Path) -> (tempfile::TempDir, PathBuf, Summary) {
             assert_eq!(rows.len(), h.steps + 1);
             let (header, rows) = read_csv(&out.join("cycles.csv"));
             assert_eq!(header, CYCLES_HEADER);
-            assert_eq!(rows.len(), h.cycles.len());
+            assert_eq!(rows.len(), h.cycle_count);
+            assert_eq!(h.cycles.len(), h.cycle_count.min(50));
             assert_svg(&out.join("plots/hysteresis.svg"), 1);
             assert_svg(&out.join("plots/hysteresis_slip.svg"), 1);
             // The zones as bands: the contact and a stick band per phase, no lines.
@@ -623,6 +628,29 @@ fn scenario_many_cycles() {
     assert_eq!(h.verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 });
     assert_eq!(snapshot_loads(&s), [0.5, -0.5, 0.5, -0.5]);
     assert_same_traction(&out, &[(1.0, 37.0), (3.0, 39.0)], 1e-8);
+}
+
+/// Sixty cycles: `summary.json` lists the first and the last 25 turning points and cycles
+/// with their counts (121 turning points, 60 cycles), while `cycles.csv` and `steps.csv` have
+/// every cycle and step.
+#[test]
+fn a_long_history_keeps_its_summary_short_and_its_tables_whole() {
+    let text = std::fs::read_to_string(scenario_path("many_cycles")).unwrap();
+    let mut raw: serde_json::Value = serde_json::from_str(&text).unwrap();
+    raw["name"] = "sixty_cycles".into();
+    raw["tangential_history"]["repeats"] = 60.into();
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("sixty_cycles.json");
+    std::fs::write(&file, serde_json::to_string_pretty(&raw).unwrap()).unwrap();
+    let (_tmp, out, s) = run_checked(&file);
+    let h = s.history.as_ref().unwrap();
+    assert_eq!((h.cycle_count, h.cycles.len()), (60, 50));
+    assert_eq!((h.turning_point_count, h.turning_points.len()), (121, 50));
+    let first_of_last = &h.cycles[25];
+    assert_eq!(first_of_last.cycle, 36);
+    let (_, rows) = read_csv(&out.join("cycles.csv"));
+    assert_eq!(rows.len(), 60);
+    assert_eq!(h.verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 });
 }
 
 /// A block of a small (±0.2ηP) and a large (±0.6ηP) cycle, repeated three times, on the
