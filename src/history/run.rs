@@ -388,22 +388,59 @@ fn spectral_stretch(
     })
 }
 
-/// Whether the general solver's record of a step and the spectral solver's describe one state:
-/// the same phase, the same zone structure at the element resolution (a zone of one element is
-/// not a contradiction: [`ZoneCount::resolved`]), and the contact and stick ends within two
-/// elements of the general solver's mesh there.
+/// Whether the general solver's record of a step and the spectral solver's describe one state
+/// ([`disagreement`] finds nothing).
 fn agrees(run: &GeneralRun, general: &StepRecord, spectral: &StepRecord) -> bool {
-    if spectral.zones != ZoneCount::resolved(&run.state) || spectral.phase != general.phase {
-        return false;
+    disagreement(run, general, spectral).is_none()
+}
+
+/// Where the general solver's record of a step and the spectral solver's describe different
+/// states, if they do: another phase, another zone structure at the element resolution (a
+/// zone of one element is not a contradiction: [`ZoneCount::resolved`]), or a contact or
+/// stick end more than two elements of the general solver's mesh there from the other's.
+fn disagreement(run: &GeneralRun, general: &StepRecord, spectral: &StepRecord) -> Option<String> {
+    if spectral.phase != general.phase {
+        return Some(format!(
+            "the general solver's step is in phase {} where the spectral solver's is in phase {}",
+            general.phase, spectral.phase
+        ));
+    }
+    let resolved = ZoneCount::resolved(&run.state);
+    if spectral.zones != resolved {
+        return Some(format!(
+            "the general solver finds {} stick and {} slip zones ({} slip sign changes) where \
+             the spectral solver's state has {} and {} ({})",
+            resolved.stick,
+            resolved.slip,
+            resolved.sign_changes,
+            spectral.zones.stick,
+            spectral.zones.slip,
+            spectral.zones.sign_changes
+        ));
     }
     let ends = |r: &StepRecord| {
         let c = -r.eccentricity;
         [c - r.half_width, c + r.half_width, r.stick_lo, r.stick_hi]
     };
+    let names = [
+        "left contact end",
+        "right contact end",
+        "left stick end",
+        "right stick end",
+    ];
     ends(general)
-        .iter()
+        .into_iter()
         .zip(ends(spectral))
-        .all(|(&g, s)| (g - s).abs() <= 2.0 * run.state.mesh.width_at(g))
+        .zip(names)
+        .map(|((g, s), name)| (name, g, s, (g - s).abs() / run.state.mesh.width_at(g)))
+        .filter(|&(.., elements)| elements > 2.0)
+        .max_by(|x, y| x.3.total_cmp(&y.3))
+        .map(|(name, g, s, elements)| {
+            format!(
+                "the general solver's {name} is at {g:.6e} m, the spectral solver's at \
+                 {s:.6e} m ({elements:.1} elements apart; the same zones)"
+            )
+        })
 }
 
 /// Whether the step at `point` begins a phase from the driver's state.
@@ -426,25 +463,13 @@ fn contradicted(
 ) -> Option<(StepFailure, (GeneralRun, StepRecord))> {
     let mut run = GeneralRun::handover(model, before, options.general_element_size, recall);
     let general = run.step(model, point, recall).ok()?;
-    if agrees(&run, &general, spectral) {
-        return None;
-    }
+    let reason = disagreement(&run, &general, spectral)?;
     let failure = StepFailure {
         step: point.step,
         t: point.t,
         q: point.q,
         regime: spectral.regime,
-        failure: crate::error::SolveFailure::NoAdmissibleState {
-            reason: format!(
-                "the general solver finds {} stick and {} slip zones ({} slip sign changes) \
-                 where the spectral solver's state has {} and {}",
-                general.zones.stick,
-                general.zones.slip,
-                general.zones.sign_changes,
-                spectral.zones.stick,
-                spectral.zones.slip
-            ),
-        },
+        failure: crate::error::SolveFailure::NoAdmissibleState { reason },
     };
     Some((failure, (run, general)))
 }
