@@ -88,6 +88,7 @@ pub mod material;
 pub mod quadrature;
 pub mod scenario;
 mod shared;
+pub mod subsurface;
 pub mod transforms;
 
 // The entry points most programs need, at the crate root.
