@@ -95,7 +95,8 @@
 //! Gauss–Legendre panel the kernel is integrated exactly against the polynomial interpolant
 //! (Legendre moments) when its pole is near, by Gauss–Legendre itself when far. So the fields
 //! are as accurate at depth 1e−9 a as at depth a: the error is the interpolation error of the
-//! densities.
+//! densities. Loads constant on elements (the general solver's element states,
+//! [`SurfaceLoads::of_elements`]) are integrated exactly element by element instead.
 //!
 //! Measured (tests of this module and of `rule`):
 //! - closed-form Cauchy transforms (`√(1 − t²)`, `1/√(1 − t²)`, an interior half-ellipse) at
@@ -108,7 +109,16 @@
 //!   agrees with eqs. (64)–(65) to 1.3e−9 and 7e−11; the resultants equal P, Q and Γ to
 //!   6e−14 (stresses) and 9e−12 (charge) at every depth;
 //! - a Stroh kernel of isotropic stiffness with c44 = μ(1 + δ) differs from Flamant's by
-//!   8.2 δ p0 (δ = 1e−2 … 1e−4).
+//!   8.2 δ p0 (δ = 1e−2 … 1e−4);
+//! - Hertz loads as averages on N elements: McEwen's fields to 6e−4 … 1.1e−5 p0 for
+//!   N = 64 … 512 (second order), resultants exact to 3e−15.
+//!
+//! # Use
+//! [`SubsurfaceKernel::try_new`] for the material, [`SurfaceLoads::of_state`] (a spectral
+//! state), [`SurfaceLoads::of_elements`] (an element state), [`SurfaceLoads::from_samples`] or
+//! [`SurfaceLoads::from_elements`] (plain arrays), then [`subsurface_fields`] at the points.
+//! Cost, measured on a loaded 2-core machine: 20,000 points take 1.8 s for PZT-4 (three modes,
+//! 1,920 nodes for the default state at Q = 0.5 ηP) and 0.66 s for an isotropic solid.
 //!
 //! # References
 //! T. C. T. Ting, *Anisotropic Elasticity* (1996), ch. 8 (the half-space line-load solution in
@@ -175,6 +185,12 @@ pub enum SubsurfaceError {
         half_width: f64,
         /// Panels per half piece.
         panels_per_half: usize,
+    },
+    /// Element edges that are not finite and increasing, or fewer than two.
+    #[error("{edges} element edges: at least 2, finite and increasing, are needed")]
+    Elements {
+        /// How many edges were given.
+        edges: usize,
     },
     /// A matrix of the Stroh solution is singular.
     #[error("the {matrix} is singular")]
@@ -287,12 +303,69 @@ impl SubsurfaceKernel {
     }
 }
 
-/// The surface loads of one instant on a [`SurfaceRule`]: p, q and g at its nodes.
+/// The surface loads of one instant: p, q and g at the nodes of a [`SurfaceRule`] (a spectral
+/// state, sampled densities), or constant on elements (the general solver's element states).
 #[derive(Debug, Clone)]
 pub struct SurfaceLoads {
-    rule: SurfaceRule,
-    /// `2v f` at the nodes for f = q, p, g (the order of the z-face traction).
-    weighted: [Vec<f64>; 3],
+    representation: Representation,
+}
+
+#[derive(Debug, Clone)]
+enum Representation {
+    /// `2v f` at the rule's nodes for f = q, p, g (the order of the z-face traction).
+    Rule {
+        rule: Box<SurfaceRule>,
+        weighted: [Vec<f64>; 3],
+    },
+    /// Element edges `e_j` (increasing) and the values `f_j` on `[e_j, e_{j+1}]`, for
+    /// f = q, p, g: exactly
+    /// `F(ζ) = (1/π) Σ_j f_j Log((e_{j+1} − ζ)/(e_j − ζ))` (the principal logarithm of the
+    /// ratio is the integral along the element, which does not pass through ζ) and
+    /// `F'(ζ) = (1/π) Σ_j f_j (e_{j+1} − e_j)/((e_j − ζ)(e_{j+1} − ζ))`. Far from an element
+    /// the logarithm is `ln(1 + w)`, `w = (e_{j+1} − e_j)/(e_j − ζ)`, by its series, so that
+    /// the fields keep their relative accuracy as they decay.
+    Elements {
+        edges: Vec<f64>,
+        values: [Vec<f64>; 3],
+    },
+}
+
+impl Representation {
+    /// `(1/π)∫ f/(s − ζ) ds` (and its ζ-derivative when `derivative`) of the densities
+    /// `which` (0 = q, 1 = p, 2 = g).
+    fn cauchy<const D: usize>(
+        &self,
+        which: [usize; D],
+        zeta: C64,
+        derivative: bool,
+    ) -> ([C64; D], [C64; D]) {
+        match self {
+            Representation::Rule { rule, weighted } => {
+                rule.cauchy(which.map(|k| weighted[k].as_slice()), zeta, derivative)
+            }
+            Representation::Elements { edges, values } => {
+                let zero = C64::new(0.0, 0.0);
+                let (mut f, mut df) = ([zero; D], [zero; D]);
+                for (j, e) in edges.windows(2).enumerate() {
+                    if which.iter().all(|&k| values[k][j] == 0.0) {
+                        continue;
+                    }
+                    let (from, to) = (C64::new(e[0], 0.0) - zeta, C64::new(e[1], 0.0) - zeta);
+                    let w = (e[1] - e[0]) / from;
+                    let log = ln_1p(w);
+                    let slope = (from * to).inv() * (e[1] - e[0]);
+                    for (d, &k) in which.iter().enumerate() {
+                        f[d] += log * values[k][j];
+                        if derivative {
+                            df[d] += slope * values[k][j];
+                        }
+                    }
+                }
+                let pi = std::f64::consts::PI;
+                (f.map(|v| v / pi), df.map(|v| v / pi))
+            }
+        }
+    }
 }
 
 impl SurfaceLoads {
@@ -324,7 +397,55 @@ impl SurfaceLoads {
             }
             weighted[k] = rule.weighted(values);
         }
-        Ok(Self { rule, weighted })
+        Ok(Self {
+            representation: Representation::Rule {
+                rule: Box::new(rule),
+                weighted,
+            },
+        })
+    }
+
+    /// From values constant on elements: `edges` (m, N + 1, increasing) and p (Pa), q (Pa),
+    /// g (C/m²) on each of the N elements, zero outside them; integrated exactly (a
+    /// piecewise-constant density is what the general solver's element states hold,
+    /// [`crate::contact::general::GeneralState`]).
+    pub fn from_elements(
+        edges: &[f64],
+        pressure: &[f64],
+        traction: &[f64],
+        charge: &[f64],
+    ) -> Result<Self, SubsurfaceError> {
+        let n = edges.len().saturating_sub(1);
+        if n == 0 || edges.iter().any(|e| !e.is_finite()) || edges.windows(2).any(|w| w[1] <= w[0])
+        {
+            return Err(SubsurfaceError::Elements { edges: edges.len() });
+        }
+        let mut element_values: [Vec<f64>; 3] = Default::default();
+        for (k, (density, values)) in [("q", traction), ("p", pressure), ("g", charge)]
+            .into_iter()
+            .enumerate()
+        {
+            if values.len() != n {
+                return Err(SubsurfaceError::SampleCount {
+                    density,
+                    given: values.len(),
+                    expected: n,
+                });
+            }
+            if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+                return Err(SubsurfaceError::NotFinite {
+                    density,
+                    x: 0.5 * (edges[i] + edges[i + 1]),
+                });
+            }
+            element_values[k] = values.to_vec();
+        }
+        Ok(Self {
+            representation: Representation::Elements {
+                edges: edges.to_vec(),
+                values: element_values,
+            },
+        })
     }
 
     /// From a function of x giving `(p, q, g)` (Pa, Pa, C/m²) on the contact.
@@ -372,10 +493,40 @@ impl SurfaceLoads {
         Self::from_samples(rule, &p, &q, &g)
     }
 
-    /// The rule the loads are sampled on.
-    pub fn rule(&self) -> &SurfaceRule {
-        &self.rule
+    /// The loads of an element state of the general solver ([`Self::from_elements`] on its
+    /// mesh).
+    pub fn of_elements(
+        state: &crate::contact::general::GeneralState,
+    ) -> Result<Self, SubsurfaceError> {
+        Self::from_elements(
+            &state.mesh.edges,
+            &state.pressure,
+            &state.shear,
+            &state.charge,
+        )
     }
+
+    /// The rule the loads are sampled on; `None` for element loads.
+    pub fn rule(&self) -> Option<&SurfaceRule> {
+        match &self.representation {
+            Representation::Rule { rule, .. } => Some(rule),
+            Representation::Elements { .. } => None,
+        }
+    }
+}
+
+/// `ln(1 + w)` (principal), by its series for `|w| < 1/8` (18 terms: below 1e−17).
+fn ln_1p(w: C64) -> C64 {
+    if w.norm() >= 0.125 {
+        return (w + 1.0).ln();
+    }
+    let mut power = w;
+    let mut sum = w;
+    for k in 2..=18 {
+        power *= -w;
+        sum += power / k as f64;
+    }
+    sum
 }
 
 /// Where the densities of a contact state are not smooth inside the contact: the traction's
@@ -477,8 +628,7 @@ pub fn subsurface_fields(
 
 /// Flamant's kernel (module docs).
 fn isotropic_point(nu: f64, loads: &SurfaceLoads, (x, z): (f64, f64)) -> SubsurfacePoint {
-    let [q, p, _] = &loads.weighted;
-    let ([fq, fp], [dq, dp]) = loads.rule.cauchy([q, p], C64::new(x, z), true);
+    let ([fq, fp], [dq, dp]) = loads.representation.cauchy([0, 1], C64::new(x, z), true);
     let szz = -fp.im + z * dp.re + z * dq.im;
     let sxx = -fp.im - z * dp.re + 2.0 * fq.re - z * dq.im;
     let sxz = z * dp.im - fq.im - z * dq.re;
@@ -493,12 +643,11 @@ fn piezoelectric_point(
     loads: &SurfaceLoads,
     (x, z): (f64, f64),
 ) -> SubsurfacePoint {
-    let [q, p, g] = &loads.weighted;
     let zero = Vector3::<C64>::zeros();
     let (mut t, mut s, mut dx, mut dz) = (zero, zero, zero, zero);
     for k in 0..3 {
         let pk = modes.roots[k];
-        let ([fq, fp, fg], _) = loads.rule.cauchy([q, p, g], pk * z + x, false);
+        let ([fq, fp, fg], _) = loads.representation.cauchy([0, 1, 2], pk * z + x, false);
         // Cauchy integrals of the z-face traction t0 = −(q, p, g).
         let f = -Vector3::new(fq, fp, fg);
         let tk = modes.traction[k] * f;
@@ -533,11 +682,10 @@ fn piezoelectric_shear_from_x_face(
     let Kind::Piezoelectric { modes, .. } = &kernel.kind else {
         panic!("piezoelectric kernel expected")
     };
-    let [q, p, g] = &loads.weighted;
     let mut s = C64::new(0.0, 0.0);
     for k in 0..3 {
         let pk = modes.roots[k];
-        let ([fq, fp, fg], _) = loads.rule.cauchy([q, p, g], pk * z + x, false);
+        let ([fq, fp, fg], _) = loads.representation.cauchy([0, 1, 2], pk * z + x, false);
         let f = -Vector3::new(fq, fp, fg);
         s -= (modes.traction[k] * f)[1] * pk;
     }
