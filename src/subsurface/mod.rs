@@ -225,9 +225,10 @@ pub enum SubsurfaceError {
 }
 
 /// c12 (Pa) of the built-in piezoelectric presets (stiffness at constant field), for σyy:
-/// Berlincourt, Curran & Jaffe (1964) as tabulated by Auld, *Acoustic Fields and Waves in
-/// Solids* I (1973), App. 2 — the source of the presets' other constants (PZT-4 7.78e10,
-/// PZT-5H 7.95e10, BaTiO3 6.6e10).
+/// Berlincourt, Curran & Jaffe (1964), the source of the presets' other constants, as
+/// tabulated by Auld, *Acoustic Fields and Waves in Solids* I (1973), App. 2: PZT-4 7.78e10,
+/// PZT-5H 7.95e10, BaTiO3 6.6e10. (Consistent with the tabulated `c66 = (c11 − c12)/2`:
+/// 3.06e10, 2.33e10, 4.2e10.)
 pub const PRESET_C12: [(&str, f64); 3] = [("pzt4", 77.8e9), ("pzt5h", 79.5e9), ("batio3", 66.0e9)];
 
 /// c12 of a built-in preset whose constants these are exactly ([`PRESET_C12`]), else `None`.
