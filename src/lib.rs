@@ -74,7 +74,8 @@
 //!   records and the [`history::Observer`] of a run.
 //! - [`analysis`]: the cycles of a history, the energy per cycle and the verdict;
 //!   [`analytical`]: closed-form oracles; [`halfplane`]: the surface compliance (extended
-//!   Stroh formalism), the paper's f_ij, Δ1…Δ4.
+//!   Stroh formalism), the paper's f_ij, Δ1…Δ4; [`subsurface`]: the stresses and electric
+//!   fields below the surface from p, q and g.
 //! - [`io`]: solving a scenario and writing its output folder; [`cli`]: the command;
 //!   [`error`]: errors and their exit codes.
 //!
@@ -134,6 +135,7 @@ pub mod prelude;
 internal! { mod quadrature; }
 pub mod scenario;
 mod shared;
+pub mod subsurface;
 internal! { mod transforms; }
 
 // The entry points most programs need, at the crate root.
