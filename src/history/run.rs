@@ -409,7 +409,7 @@ fn disagreement(run: &GeneralRun, general: &StepRecord, spectral: &StepRecord) -
     if spectral.zones != resolved {
         return Some(format!(
             "the general solver finds {} stick and {} slip zones ({} slip sign changes) where \
-             the spectral solver's state has {} and {} ({})",
+             the spectral solver's state has {} and {} ({} slip sign changes)",
             resolved.stick,
             resolved.slip,
             resolved.sign_changes,
