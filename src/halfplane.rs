@@ -227,7 +227,9 @@ fn isotropic(c: &IsotropicConstants) -> SurfaceCompliance {
 }
 
 /// Dimensionless generalised constants blocks (Q, R, T) of a piezoelectric solid.
-fn stroh_blocks(c: &PiezoConstants) -> (Matrix3<f64>, Matrix3<f64>, Matrix3<f64>, Scales) {
+pub(crate) fn stroh_blocks(
+    c: &PiezoConstants,
+) -> (Matrix3<f64>, Matrix3<f64>, Matrix3<f64>, Scales) {
     let c0 = c.c44;
     let eps0 = c.eps33;
     let e0 = (c0 * eps0).sqrt();
@@ -240,10 +242,10 @@ fn stroh_blocks(c: &PiezoConstants) -> (Matrix3<f64>, Matrix3<f64>, Matrix3<f64>
     (q, r, t, Scales { c0, e0, eps0 })
 }
 
-struct Scales {
-    c0: f64,
-    e0: f64,
-    eps0: f64,
+pub(crate) struct Scales {
+    pub(crate) c0: f64,
+    pub(crate) e0: f64,
+    pub(crate) eps0: f64,
 }
 
 /// `Y = i A B⁻¹` for the decaying modes of the Stroh matrix built from (Q, R, T); an error

@@ -481,6 +481,12 @@ impl SurfaceLoads {
             half_width,
             panels_per_half,
         })?;
+        Self::sampled(state, rule)
+    }
+
+    /// The loads of a contact state sampled at the nodes of `rule`: p, q and
+    /// `g = k p + w` (the charge split of the conducting punch).
+    pub fn sampled(state: &ContactState, rule: SurfaceRule) -> Result<Self, SubsurfaceError> {
         let nodes = rule.nodes();
         let (mut p, mut q, mut w) = (Vec::new(), Vec::new(), Vec::new());
         state.pressures_into(&nodes, &mut p);

@@ -55,16 +55,8 @@ pub(crate) struct Modes {
 /// Dimensionless blocks `(Q, R, T)` and the scales `(c0, e0, ε0)` of [`crate::halfplane`]:
 /// `c/c44`, `e/√(c44 ε33)`, `ε/ε33`.
 fn blocks(c: &PiezoConstants) -> ([Matrix3<f64>; 3], (f64, f64, f64)) {
-    let c0 = c.c44;
-    let eps0 = c.eps33;
-    let e0 = (c0 * eps0).sqrt();
-    let (c11, c13, c33, c44) = (c.c11 / c0, c.c13 / c0, c.c33 / c0, c.c44 / c0);
-    let (e31, e33, e15) = (c.e31 / e0, c.e33 / e0, c.e15 / e0);
-    let (eps11, eps33) = (c.eps11 / eps0, c.eps33 / eps0);
-    let q = Matrix3::new(c11, 0.0, 0.0, 0.0, c44, e15, 0.0, e15, -eps11);
-    let r = Matrix3::new(0.0, c13, e31, c44, 0.0, 0.0, e15, 0.0, 0.0);
-    let t = Matrix3::new(c44, 0.0, 0.0, 0.0, c33, e33, 0.0, e33, -eps33);
-    ([q, r, t], (c0, e0, eps0))
+    let (q, r, t, s) = crate::halfplane::stroh_blocks(c);
+    ([q, r, t], (s.c0, s.e0, s.eps0))
 }
 
 /// The null vector of a singular complex 3×3 matrix, unit norm: the largest of the (bilinear)

@@ -580,17 +580,7 @@ fn fields_converge_as_the_panels_are_refined() {
         }
         let fields = |k: usize, l: usize| {
             let rule = SurfaceRule::with_grading(c, a, &breaks, k, l).unwrap();
-            let nodes = rule.nodes();
-            let (mut p, mut q, mut w) = (Vec::new(), Vec::new(), Vec::new());
-            state.pressures_into(&nodes, &mut p);
-            state.tractions_with(&nodes, &p, &mut q);
-            state.potential_charges_into(&nodes, &mut w);
-            let g: Vec<f64> = p
-                .iter()
-                .zip(&w)
-                .map(|(p, w)| state.split.ratio * p + w)
-                .collect();
-            let loads = SurfaceLoads::from_samples(rule, &p, &q, &g).unwrap();
+            let loads = SurfaceLoads::sampled(state, rule).unwrap();
             subsurface_fields(&kernel, &loads, &points).unwrap()
         };
         let reference = fields(16, 8);
