@@ -1,9 +1,9 @@
-//! What each speed-up of `Accelerations` gains on a whole run: the default scenario solved as
-//! `fretsim run` solves it (normal loading and the whole history, without writing), with
-//! every speed-up on, with each one off, and with all of them off (the reference path); and the
-//! same with the spectral solver alone (`RunOptions::spectral`, without the general solver's
-//! checks of the phase starts, which take most of the default run and which no switch
-//! touches).
+//! What each speed-up of `Accelerations` gains on a whole run: a scenario (the default one, or
+//! `--scenario FILE`) solved as `fretsim run` solves it (normal loading and the whole history,
+//! without writing), with every speed-up on, with each one off, and with all of them off (the
+//! reference path); and the same with the spectral solver alone (`RunOptions::spectral`,
+//! without the general solver's checks of the phase starts, which take most of the default run
+//! and which no switch touches).
 //!
 //! The variants are timed in rounds, each round running every variant once in a rotated
 //! order, so that a change of the host's load falls on all of them alike (on a shared host,
@@ -15,6 +15,7 @@
 //! cargo bench --bench accelerations               # 15 rounds
 //! cargo bench --bench accelerations -- --rounds 30
 //! cargo bench --bench accelerations -- --m 256 --spectral   # another M, spectral solver only
+//! cargo bench --bench accelerations -- --scenario FILE --only chain_tables,exterior_tables --rounds 3
 //! ```
 
 use std::hint::black_box;
@@ -31,11 +32,15 @@ use fretsim::history::{NoObserver, RunOptions, StepRecord, run_history};
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
-/// The default scenario solved with `accelerations` (the normal-loading zone's tables with
-/// `chain_tables` and `exterior_tables`), by the scenario's solver choice or, with
-/// `spectral`, by the spectral solver alone, on `m` collocation points.
-fn default_run(accelerations: Accelerations, spectral: bool, m: usize) -> Vec<StepRecord> {
-    let sc = fretsim::scenario::default_scenario();
+/// A scenario (the default one unless `--scenario FILE`) solved with `accelerations` (the
+/// normal-loading zone's tables with `chain_tables` and `exterior_tables`), by the scenario's
+/// solver choice or, with `spectral`, by the spectral solver alone, on `m` collocation points.
+fn default_run(
+    sc: &fretsim::Scenario,
+    accelerations: Accelerations,
+    spectral: bool,
+    m: usize,
+) -> Vec<StepRecord> {
     let disc = Discretisation::new(m);
     let normal_options = NormalOptions {
         zone_tables: ZoneTables {
@@ -63,7 +68,7 @@ type SwitchOff = fn(&mut Accelerations);
 /// Every speed-up on, each one off, and all off.
 fn variants() -> Vec<(String, Accelerations)> {
     let on = Accelerations::default();
-    let off: [(&str, SwitchOff); 8] = [
+    let off: [(&str, SwitchOff); 10] = [
         ("recall", |a| a.recall = false),
         ("coarse_jacobian", |a| a.coarse_jacobian = false),
         ("mixed_start_guesses", |a| a.mixed_start_guesses = false),
@@ -72,6 +77,8 @@ fn variants() -> Vec<(String, Accelerations)> {
         ("lent_maps", |a| a.lent_maps = false),
         ("chain_tables", |a| a.chain_tables = false),
         ("exterior_tables", |a| a.exterior_tables = false),
+        ("continuation", |a| a.continuation = false),
+        ("general_recall", |a| a.general_recall = false),
     ];
     let mut all = vec![("all on".to_string(), on)];
     for (name, switch_off) in off {
@@ -102,7 +109,20 @@ fn main() {
             .and_then(|n| n.parse().ok())
     };
     let rounds = value("--rounds").unwrap_or(15);
-    let m = value("--m").unwrap_or(fretsim::scenario::default_scenario().collocation_points);
+    let text = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1))
+            .cloned()
+    };
+    let sc = match text("--scenario") {
+        Some(path) => fretsim::load(std::path::Path::new(&path)).expect("a valid scenario"),
+        None => fretsim::scenario::default_scenario(),
+    };
+    let m = value("--m").unwrap_or(sc.collocation_points);
+    // `--only a,b`: all on, the reference, and the variants without a or b.
+    let only: Option<Vec<String>> =
+        text("--only").map(|s| s.split(',').map(|w| format!("without {w}")).collect());
     let solvers: &[bool] = if args.iter().any(|a| a == "--spectral") {
         &[true]
     } else {
@@ -111,7 +131,13 @@ fn main() {
     if args.iter().any(|a| a == "--list") {
         return;
     }
-    let variants = variants();
+    let variants: Vec<(String, Accelerations)> = variants()
+        .into_iter()
+        .filter(|(name, _)| {
+            only.as_ref()
+                .is_none_or(|o| !name.starts_with("without") || o.iter().any(|w| w == name))
+        })
+        .collect();
     let n = variants.len();
     for &spectral in solvers {
         let solver = if spectral {
@@ -122,7 +148,7 @@ fn main() {
         let evaluations: Vec<usize> = variants
             .iter()
             .map(|(_, a)| {
-                default_run(*a, spectral, m)
+                default_run(&sc, *a, spectral, m)
                     .iter()
                     .map(|r| r.newton_iterations)
                     .sum()
@@ -133,12 +159,15 @@ fn main() {
             for k in 0..n {
                 let v = (k + round) % n;
                 let start = Instant::now();
-                black_box(default_run(variants[v].1, spectral, m));
+                black_box(default_run(&sc, variants[v].1, spectral, m));
                 times[v].push(start.elapsed().as_secs_f64() * 1e3);
             }
         }
         let medians: Vec<f64> = times.into_iter().map(median).collect();
-        println!("\nDefault run at M = {m}, {solver}: median of {rounds} rounds");
+        println!(
+            "\n{} at M = {m}, {solver}: median of {rounds} rounds",
+            sc.name
+        );
         println!("| variant | median (ms) | − all on (ms) | residual evaluations |");
         println!("|---|---|---|---|");
         for ((name, _), (m, e)) in variants.iter().zip(medians.iter().zip(&evaluations)) {
