@@ -15,7 +15,10 @@
 //! cargo bench --bench accelerations               # 15 rounds
 //! cargo bench --bench accelerations -- --rounds 30
 //! cargo bench --bench accelerations -- --m 256 --spectral   # another M, spectral solver only
-//! cargo bench --bench accelerations -- --scenario FILE --only chain_tables,exterior_tables --rounds 3
+//! # long histories (`benches/scenarios/`): 100 random reversals (PZT-4 default contact,
+//! # amplitudes uniform in 0.1–0.7 ηP, seed 7, 5 steps a reversal) and 1,000 steady cycles
+//! cargo bench --bench accelerations -- --scenario benches/scenarios/random_variable_amplitude_100.json \
+//!     --only chain_tables,exterior_tables --rounds 9 --spectral
 //! ```
 
 use std::hint::black_box;
