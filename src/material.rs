@@ -246,6 +246,25 @@ fn check_poisson(issues: &mut Vec<Issue>, path: &str, nu: f64) {
 }
 
 impl PiezoConstants {
+    /// An isotropic elastic solid (shear modulus μ, Poisson's ratio ν) written as
+    /// piezoelectric constants without coupling (e = 0), with permittivities ε11, ε33: the
+    /// degenerate case of the Stroh formalism that the tests check the kernels against.
+    #[cfg(test)]
+    pub(crate) fn uncoupled_isotropic(mu: f64, nu: f64, eps11: f64, eps33: f64) -> Self {
+        let lambda = 2.0 * mu * nu / (1.0 - 2.0 * nu);
+        Self {
+            c11: lambda + 2.0 * mu,
+            c13: lambda,
+            c33: lambda + 2.0 * mu,
+            c44: mu,
+            e31: 0.0,
+            e33: 0.0,
+            e15: 0.0,
+            eps11,
+            eps33,
+        }
+    }
+
     /// Every problem with the constants, each naming the constant (`path` is prefixed):
     /// finite, in range, and the elastic and dielectric matrices positive definite.
     pub fn validate(&self, path: &str) -> Vec<Issue> {

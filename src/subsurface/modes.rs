@@ -273,19 +273,7 @@ mod tests {
         // The isotropic solid written as piezoelectric constants (e = 0, ε11 ≠ ε33 so the
         // electric root i·√(ε11/ε33) stays apart): the mechanical root p = i is double, B is
         // singular and the Stroh kernel does not apply (the isotropic kernel does).
-        let (mu, nu) = (27.3e9, 0.3);
-        let lambda = 2.0 * mu * nu / (1.0 - 2.0 * nu);
-        let c = PiezoConstants {
-            c11: lambda + 2.0 * mu,
-            c13: lambda,
-            c33: lambda + 2.0 * mu,
-            c44: mu,
-            e31: 0.0,
-            e33: 0.0,
-            e15: 0.0,
-            eps11: 2e-9,
-            eps33: 1e-9,
-        };
+        let c = PiezoConstants::uncoupled_isotropic(27.3e9, 0.3, 2e-9, 1e-9);
         let err = Modes::of(&c).unwrap_err();
         assert!(
             matches!(
