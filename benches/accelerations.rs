@@ -18,7 +18,7 @@
 //! # long histories (`benches/scenarios/`): 100 random reversals (PZT-4 default contact,
 //! # amplitudes uniform in 0.1–0.7 ηP, seed 7, 5 steps a reversal) and 1,000 steady cycles
 //! cargo bench --bench accelerations -- --scenario benches/scenarios/random_variable_amplitude_100.json \
-//!     --only chain_tables,exterior_tables --rounds 9 --spectral
+//!     --only chain_tables,fade_table_reuse --rounds 9 --spectral
 //! ```
 
 use std::hint::black_box;
@@ -36,7 +36,7 @@ use fretsim::history::{NoObserver, RunOptions, StepRecord, run_history};
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 /// A scenario (the default one unless `--scenario FILE`) solved with `accelerations` (the
-/// normal-loading zone's tables with `chain_tables` and `exterior_tables`), by the scenario's
+/// normal-loading zone's tables with `chain_tables`), by the scenario's
 /// solver choice or, with `spectral`, by the spectral solver alone, on `m` collocation points.
 fn default_run(
     sc: &fretsim::Scenario,
@@ -48,7 +48,6 @@ fn default_run(
     let normal_options = NormalOptions {
         zone_tables: ZoneTables {
             chain: accelerations.chain_tables,
-            exterior: accelerations.exterior_tables,
         },
         ..NormalOptions::default()
     };
@@ -71,7 +70,7 @@ type SwitchOff = fn(&mut Accelerations);
 /// Every speed-up on, each one off, and all off.
 fn variants() -> Vec<(String, Accelerations)> {
     let on = Accelerations::default();
-    let off: [(&str, SwitchOff); 10] = [
+    let off: [(&str, SwitchOff); 9] = [
         ("recall", |a| a.recall = false),
         ("coarse_jacobian", |a| a.coarse_jacobian = false),
         ("mixed_start_guesses", |a| a.mixed_start_guesses = false),
@@ -79,7 +78,6 @@ fn variants() -> Vec<(String, Accelerations)> {
         ("fade_table_reuse", |a| a.fade_table_reuse = false),
         ("lent_maps", |a| a.lent_maps = false),
         ("chain_tables", |a| a.chain_tables = false),
-        ("exterior_tables", |a| a.exterior_tables = false),
         ("continuation", |a| a.continuation = false),
         ("general_recall", |a| a.general_recall = false),
     ];

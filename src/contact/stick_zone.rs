@@ -50,46 +50,35 @@ pub struct StickZone {
     /// q̃ tabulated with it.
     #[serde(skip_serializing)]
     pub(super) value_table: TableCache,
-    /// `H'q̃` on the two outer pieces alone, `[lo − w, lo]` and `[hi, hi + w]` (w the zone's
-    /// width), for a zone without [`Self::tabulate`]'s table whose transform is wanted at many
-    /// points of the slip zones (`EXTERIOR_TABLE_POINTS`; the checks and increments of the
-    /// steps it ends and begins).
-    pub(super) exterior_table: TableCache<[ChainTable; 2]>,
     /// Which of the tables above the zone may build (written only when not all).
     #[serde(skip_serializing_if = "ZoneTables::all")]
     pub tables: ZoneTables,
 }
 
 /// Which tables a [`StickZone`] may build: [`StickZone::tabulate`]'s piecewise tables of
-/// `H'q̃` and q̃ (`chain`), and the exterior tables of `H'q̃` beside its ends (`exterior`).
-/// Both in [`Default`]; a zone that may build neither evaluates its chain directly
+/// `H'q̃` and q̃ (`chain`), in [`Default`]; a zone that may not evaluates its chain directly
 /// ([`crate::contact::tangential::Accelerations`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ZoneTables {
     /// [`StickZone::tabulate`]'s tables.
     pub chain: bool,
-    /// The exterior tables.
-    pub exterior: bool,
 }
 
 impl Default for ZoneTables {
     fn default() -> Self {
-        Self {
-            chain: true,
-            exterior: true,
-        }
+        Self { chain: true }
     }
 }
 
 impl ZoneTables {
     /// Whether every table is allowed.
     fn all(&self) -> bool {
-        self.chain && self.exterior
+        self.chain
     }
 }
 
-/// A [`StickZone`] as written: its data, and which of its tables were built (the points per
-/// piece of [`StickZone::tabulate`]'s, whether the exterior ones were), rebuilt on reading.
+/// A [`StickZone`] as written: its data, and whether [`StickZone::tabulate`]'s tables were
+/// built (the points per piece), rebuilt on reading.
 /// A table is a function of the zone and of its chain, whose zones are read (and tabulated)
 /// first and were tabulated before any zone inherited from them.
 #[derive(Deserialize)]
@@ -104,7 +93,6 @@ struct StickZoneData {
     end_signs: [f64; 2],
     extras: Vec<(f64, f64, f64)>,
     cauchy_table: Option<usize>,
-    exterior_table: bool,
     #[serde(default)]
     tables: ZoneTables,
 }
@@ -121,9 +109,6 @@ impl From<StickZoneData> for StickZone {
         };
         if let Some(nodes) = d.cauchy_table {
             zone.tabulate(nodes);
-        }
-        if d.exterior_table {
-            zone.build_exterior_tables();
         }
         zone
     }
@@ -149,27 +134,16 @@ impl ChainTable {
     /// The table of f on the pieces between `ends`, `nodes` Chebyshev points per piece in the
     /// graded variable.
     fn interpolating(ends: Vec<f64>, nodes: usize, f: impl Fn(f64) -> f64) -> Self {
-        Self::interpolating_batch(ends, nodes, |xs, out| out.extend(xs.iter().map(|&x| f(x))))
-    }
-
-    /// [`Self::interpolating`] with f evaluated at all the pieces' points in one call
-    /// (`f(xs, out)` pushes the values onto `out`, passed empty).
-    fn interpolating_batch(
-        ends: Vec<f64>,
-        nodes: usize,
-        f: impl FnOnce(&[f64], &mut Vec<f64>),
-    ) -> Self {
         let ChebyshevPoints { v, transforms } = ChebyshevPoints::of(nodes);
-        let points: Vec<f64> = ends
+        let all: Vec<f64> = ends
             .windows(2)
             .flat_map(|w| {
                 let (mid, half) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
                 v.iter()
                     .map(move |v| mid + half * (std::f64::consts::FRAC_PI_2 * v).sin())
             })
+            .map(f)
             .collect();
-        let mut all = Vec::with_capacity(points.len());
-        f(&points, &mut all);
         // The coefficients `c_j = (2 − δ_j0)/N Σ_k f_k cos(j θ_k)`: a discrete cosine transform.
         let coefficients = all
             .chunks_exact(nodes)
@@ -307,33 +281,6 @@ impl Serialize for TableCache {
     }
 }
 
-/// Written as whether it was built.
-impl Serialize for TableCache<[ChainTable; 2]> {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        self.0.get().is_some().serialize(serializer)
-    }
-}
-
-/// Chebyshev points per piece of a zone's exterior tables ([`StickZone::correction_cauchys_into`])
-/// for series of M terms: near a stick end the transform of an M-term series varies on a
-/// scale of about 1/M² of the zone, so the points grow with M. Measured against the direct
-/// sums on every accepted zone of four coupled histories (test
-/// `exterior_tables_match_the_direct_transform`): 64 points 1e−9 at M = 128 and 3e−8 at
-/// M = 256; M/2 + 32 points 2e−12 (1.2e−11 at worst), which still moved two step dissipations
-/// of the Figure-3 history at η = 0.2 by 2.2e−8 of themselves (the pair's sum unchanged: a
-/// state's strain enters one step as the new state and the next as the old); 3M/4 + 32 points
-/// 1.0e−9 of them (1.4e−10 of the largest step's), at 1.5 % of a forward step at M = 128.
-fn exterior_table_nodes(terms: usize) -> usize {
-    terms * 3 / 4 + 32
-}
-
-/// Points on the exterior pieces that make a batch of [`StickZone::correction_cauchys_into`]
-/// tabulate the transform there. A step's slip check asks for about 300 at M = 128, its
-/// dissipation about 500, and the next step's as many again of the same zone as the old
-/// state; the tables cost `2 exterior_table_nodes(M)` direct sums (256 at M = 128), so below
-/// this many points direct sums are cheaper and above it the table pays for itself.
-const EXTERIOR_TABLE_POINTS: usize = 128;
-
 /// The largest move of a fade ramp's points, relative to its length, over which an evaluation
 /// reuses a fade table built for the earlier ramps ([`Inherited::reusing_table_of`]).
 pub(super) const FADE_TABLE_REUSE: f64 = 1e-5;
@@ -390,7 +337,6 @@ impl StickZone {
             extras: Vec::new(),
             cauchy_table: TableCache::default(),
             value_table: TableCache::default(),
-            exterior_table: TableCache::default(),
             tables: ZoneTables::default(),
         }
     }
@@ -560,102 +506,27 @@ impl StickZone {
         self.extras.iter().map(|&(u, v, amp)| amp * f(u, v)).sum()
     }
 
-    /// `H'q̃(x)` (Pa), including the inherited chain (from [`Self::tabulate`]'s table or the
-    /// exterior tables of [`Self::correction_cauchys_into`] when the zone has them).
+    /// `H'q̃(x)` (Pa), including the inherited chain (from [`Self::tabulate`]'s table when
+    /// the zone has it).
     pub fn correction_cauchy(&self, x: f64) -> f64 {
-        let table = match self.cauchy_table.0.get() {
-            Some(table) => table.at(x),
-            None => self
-                .exterior_table
-                .0
-                .get()
-                .and_then(|tables| tables.iter().find_map(|t| t.at(x))),
-        };
-        table.unwrap_or_else(|| self.direct_cauchy(x))
+        self.cauchy_table
+            .0
+            .get()
+            .and_then(|table| table.at(x))
+            .unwrap_or_else(|| self.direct_cauchy(x))
     }
 
     /// [`Self::correction_cauchy`] at each of `xs` into `out`, bit-identical (the own series
     /// eight (`OWN_LANES`) points at a time, [`BoundedSeries::cauchys`], and the chain's fade
-    /// integrals in batches, [`Inherited::cauchy_into`]). A zone without [`Self::tabulate`]'s
-    /// table tabulates its transform on the outer pieces `[lo − w, lo]` and `[hi, hi + w]` (w
-    /// the zone's width) at the first call with at least `EXTERIOR_TABLE_POINTS` points there
-    /// (the slip zones' points of a step's checks and increments); from then on both forms
-    /// interpolate it on those pieces.
+    /// integrals in batches, [`Inherited::cauchy_into`]).
     pub fn correction_cauchys_into(&self, xs: &[f64], out: &mut Vec<f64>) {
-        out.clear();
-        if let Some(table) = self.cauchy_table.0.get() {
-            table.values_into(xs, |x| self.direct_cauchy(x), out);
-            return;
-        }
-        let Some(tables) = self.exterior_tables(xs) else {
-            self.direct_cauchys_into(xs, out);
-            return;
-        };
-        // The points on the tables' pieces from the tables, the rest directly, each in one
-        // batch.
-        let mut on_table: [(Vec<usize>, Vec<f64>); 2] = Default::default();
-        let mut direct: (Vec<usize>, Vec<f64>) = Default::default();
-        for (k, &x) in xs.iter().enumerate() {
-            let into = match tables.iter().position(|t| t.piece(x).is_some()) {
-                Some(side) => &mut on_table[side],
-                None => &mut direct,
-            };
-            into.0.push(k);
-            into.1.push(x);
-        }
-        out.resize(xs.len(), 0.0);
-        let mut values = Vec::with_capacity(xs.len());
-        for (table, (at, points)) in tables.iter().zip(&on_table) {
-            values.clear();
-            table.values_into(
-                points,
-                |_| unreachable!("a point on the table"),
-                &mut values,
-            );
-            for (&k, &v) in at.iter().zip(&values) {
-                out[k] = v;
+        match self.cauchy_table.0.get() {
+            Some(table) => {
+                out.clear();
+                table.values_into(xs, |x| self.direct_cauchy(x), out);
             }
+            None => self.direct_cauchys_into(xs, out),
         }
-        values.clear();
-        self.direct_cauchys_into(&direct.1, &mut values);
-        for (&k, &v) in direct.0.iter().zip(&values) {
-            out[k] = v;
-        }
-    }
-
-    /// The exterior tables (`exterior_table`), built here when `xs` has enough points on
-    /// their pieces; `None` without them.
-    fn exterior_tables(&self, xs: &[f64]) -> Option<&[ChainTable; 2]> {
-        if let Some(tables) = self.exterior_table.0.get() {
-            return Some(tables);
-        }
-        if !self.tables.exterior {
-            return None;
-        }
-        let width = self.hi - self.lo;
-        let outer =
-            |x: f64| (x >= self.lo - width && x < self.lo) || (x > self.hi && x <= self.hi + width);
-        if xs.iter().filter(|&&x| outer(x)).count() < EXTERIOR_TABLE_POINTS {
-            return None;
-        }
-        Some(self.build_exterior_tables())
-    }
-
-    /// Build the exterior tables (no-op if built).
-    fn build_exterior_tables(&self) -> &[ChainTable; 2] {
-        let width = self.hi - self.lo;
-        self.exterior_table.0.get_or_init(|| {
-            let nodes = exterior_table_nodes(self.series_terms());
-            let table = |from: f64, to: f64| {
-                ChainTable::interpolating_batch(vec![from, to], nodes, |xs, out| {
-                    self.direct_cauchys_into(xs, out)
-                })
-            };
-            [
-                table(self.lo - width, self.lo),
-                table(self.hi, self.hi + width),
-            ]
-        })
     }
 
     /// [`Self::correction_cauchys_into`] from the series and the chain (no table).
@@ -777,15 +648,6 @@ impl StickZone {
             zone = z.inherited.as_ref().map(|i| i.zone.clone());
         }
         None
-    }
-
-    /// The most terms of a series in the zone or its chain (M).
-    fn series_terms(&self) -> usize {
-        std::iter::once(self)
-            .chain(self.links().map(|l| l.zone.as_ref()))
-            .map(|z| z.correction.beta.len())
-            .max()
-            .unwrap_or(0)
     }
 
     /// Number of zones in the chain.

@@ -105,10 +105,7 @@ fn evaluations(records: &[StepRecord]) -> usize {
 #[test]
 fn the_fast_path_reaches_the_reference_states() {
     let fast = default_run(Accelerations::default(), ZoneTables::default());
-    let none = ZoneTables {
-        chain: false,
-        exterior: false,
-    };
+    let none = ZoneTables { chain: false };
     let reference = default_run(Accelerations::none(), none);
     let [ends, a, c, delta, dissipation] = differences(&fast, &reference);
     let (fast_evaluations, reference_evaluations) = (evaluations(&fast), evaluations(&reference));
@@ -181,7 +178,6 @@ fn the_default_options_are_the_fast_path() {
             || none.fade_table_reuse
             || none.lent_maps
             || none.chain_tables
-            || none.exterior_tables
             || none.continuation
             || none.general_recall)
     );

@@ -7,23 +7,13 @@ use super::*;
 /// path is unchanged).
 #[test]
 fn a_zone_without_tables_builds_none_and_reads_back_so() {
-    let none = ZoneTables {
-        chain: false,
-        exterior: false,
-    };
+    let none = ZoneTables { chain: false };
     let zone = StickZone {
         tables: none,
         ..faded_chain(24, Some(96), Vec::new())
     };
     zone.tabulate(96);
-    let width = zone.hi - zone.lo;
-    let outside: Vec<f64> = (0..2 * EXTERIOR_TABLE_POINTS)
-        .map(|k| zone.hi + width * (k as f64 + 0.5) / (2 * EXTERIOR_TABLE_POINTS) as f64)
-        .collect();
-    let mut out = Vec::new();
-    zone.correction_cauchys_into(&outside, &mut out);
     assert!(zone.cauchy_table.0.get().is_none() && zone.value_table.0.get().is_none());
-    assert!(zone.exterior_table.0.get().is_none());
     let text = crate::shared::write_shared(|| serde_json::to_string(&zone)).unwrap();
     let read: StickZone = crate::shared::read_shared(|| serde_json::from_str(&text)).unwrap();
     assert_eq!(read.tables, none);
@@ -58,53 +48,6 @@ fn tabulated_cauchy_transform_matches_the_direct_one() {
     // the one-point lookup bit for bit.
     let mut batch = Vec::new();
     zone.correction_cauchys_into(&points, &mut batch);
-    for (v, &x) in batch.iter().zip(&points) {
-        assert_eq!(v.to_bits(), zone.correction_cauchy(x).to_bits(), "at {x}");
-    }
-}
-
-/// A zone without `tabulate`'s table (a step's accepted zone: a series of its own, the
-/// normal-loading-like zone faded into it, a half-ellipse extra) tabulates its transform on
-/// the outer pieces at a batch with enough points there, not before; the tables against
-/// the series and chain on both pieces, next to the stick ends (where the transform has
-/// its square root) and beyond the tables (direct); the one-point form is the batch's to
-/// the bit before and after.
-#[test]
-fn exterior_tables_match_the_direct_transform() {
-    let zone = faded_chain(128, Some(160), vec![(-0.55, 0.4, 0.2)]);
-    let direct = zone.clone();
-    let (w, mut out) = (zone.hi - zone.lo, Vec::new());
-    let few: Vec<f64> = (1..=20)
-        .map(|i| zone.hi + 0.01 * w * f64::from(i))
-        .collect();
-    zone.correction_cauchys_into(&few, &mut out);
-    assert!(
-        zone.exterior_table.0.get().is_none(),
-        "{} points",
-        few.len()
-    );
-    // Both outer pieces, graded towards the stick ends, and points beyond the tables.
-    let mut points: Vec<f64> = Vec::new();
-    for i in 1..=400 {
-        let r = w * (f64::from(i) / 400.0).powi(3);
-        points.extend([zone.lo - r, zone.hi + r]);
-    }
-    points.extend([zone.lo - 1.5 * w, zone.hi + 2.0 * w]);
-    let mut batch = Vec::new();
-    zone.correction_cauchys_into(&points, &mut batch);
-    assert!(zone.exterior_table.0.get().is_some());
-    let worst = worst_relative(
-        &points,
-        |x| zone.correction_cauchy(x),
-        |x| direct.correction_cauchy(x),
-    );
-    // Measured 5.7e−13, next to the stick ends (the closest points 2e−8 w from them; at
-    // 1e−12 w the direct sums themselves are off, by 5e−10 against the table's limit). On
-    // every accepted zone of the Figure-3 histories (η = 0.2, 0.3, insulating at 0.4) and
-    // the variable-amplitude history, M = 64 … 512, at 800 points from 1.6e−8 w to w on
-    // both sides: 2.5e−12, and 1.6e−11 for one variable-amplitude zone at M = 128. The
-    // bound is 1e−12.
-    assert!(worst < 1e-12, "worst relative difference {worst:e}");
     for (v, &x) in batch.iter().zip(&points) {
         assert_eq!(v.to_bits(), zone.correction_cauchy(x).to_bits(), "at {x}");
     }

@@ -57,11 +57,6 @@ pub struct Accelerations {
     /// [`StickZone::tabulate`]: crate::contact::StickZone::tabulate
     /// [`NormalOptions::zone_tables`]: crate::contact::normal::NormalOptions::zone_tables
     pub chain_tables: bool,
-    /// Let the stick zones the solver accepts tabulate their transform beside their ends
-    /// once a batch of points there is long enough to pay for it (exterior tables,
-    /// `EXTERIOR_TABLE_POINTS`; the slip checks and increments of the steps a zone ends and
-    /// begins).
-    pub exterior_tables: bool,
     /// Start a step within a phase from the stick ends, half-width and centre extrapolated
     /// in Q through the phase's last three steps, and a phase's first step from the centre
     /// moved by dc/dQ of the previous phase's first step (the history driver's `predict`);
@@ -87,7 +82,6 @@ impl Default for Accelerations {
             fade_table_reuse: true,
             lent_maps: true,
             chain_tables: true,
-            exterior_tables: true,
             continuation: true,
             general_recall: true,
         }
@@ -105,7 +99,6 @@ impl Accelerations {
             fade_table_reuse: false,
             lent_maps: false,
             chain_tables: false,
-            exterior_tables: false,
             continuation: false,
             general_recall: false,
         }
@@ -115,7 +108,6 @@ impl Accelerations {
     pub(crate) fn zone_tables(self) -> crate::contact::ZoneTables {
         crate::contact::ZoneTables {
             chain: self.chain_tables,
-            exterior: self.exterior_tables,
         }
     }
 }
