@@ -4,6 +4,8 @@
 
 use serde::Serialize;
 
+use crate::history::StepRecord;
+
 /// One fretting cycle: from a positive extreme of Q to the next.
 #[derive(Debug, Clone, Serialize)]
 pub struct CycleRow {
@@ -60,10 +62,7 @@ pub enum Verdict {
 }
 
 /// Split the records into cycles (positive extreme to positive extreme) and judge them.
-pub fn analyse_cycles(
-    records: &[crate::history::StepRecord],
-    tolerance: f64,
-) -> (Vec<CycleRow>, Verdict) {
+pub fn analyse_cycles(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>, Verdict) {
     // Positive extremes: last step of a forward phase followed by a reverse phase.
     let maxima: Vec<usize> = (1..records.len().saturating_sub(1))
         .filter(|&i| {
@@ -109,34 +108,181 @@ pub fn analyse_cycles(
             change: None,
             compared_with: None,
         };
-        // Compare with the latest earlier cycle under the same loads (start, minimum, end):
-        // the previous cycle under constant amplitude, the same cycle one block earlier under
-        // a repeated variable-amplitude block.
-        let same = |a: (f64, f64, f64), b: (f64, f64, f64)| {
-            let tol = 1e-9 * load_scale;
-            (a.0 - b.0).abs() <= tol && (a.1 - b.1).abs() <= tol && (a.2 - b.2).abs() <= tol
-        };
-        if let Some(prev) = rows.iter().rev().find(|r| same(r.loads, row.loads)) {
-            let a = hi_rec.half_width;
-            let amp = (prev.displacement_extremes.0 - prev.displacement_extremes.1)
-                .abs()
-                .max(1e-300);
-            let energy = prev.loop_area.abs().max(1e-300);
-            let d = [
-                (row.stick_at_max.0 - prev.stick_at_max.0).abs() / a,
-                (row.stick_at_max.1 - prev.stick_at_max.1).abs() / a,
-                (row.stick_at_min.0 - prev.stick_at_min.0).abs() / a,
-                (row.stick_at_min.1 - prev.stick_at_min.1).abs() / a,
-                (row.displacement_extremes.0 - prev.displacement_extremes.0).abs() / amp,
-                (row.displacement_extremes.1 - prev.displacement_extremes.1).abs() / amp,
-                (row.loop_area - prev.loop_area).abs() / energy,
-            ];
-            row.change = Some(d.into_iter().fold(0.0, f64::max));
-            row.compared_with = Some(prev.cycle);
-        }
+        compare_with_earlier(&rows, &mut row, hi_rec.half_width, load_scale);
         rows.push(row);
     }
-    let verdict = if rows.is_empty() {
+    let verdict = judge(&rows, load_scale, tolerance);
+    (rows, verdict)
+}
+
+/// [`analyse_cycles`] as the records arrive, holding the cycle under way and not the records:
+/// [`CycleAnalysis::push`] each record in order, then [`CycleAnalysis::finish`]. Its rows and
+/// verdict are those of [`analyse_cycles`] on the same records, to the bit (the sums are taken
+/// in the same order). The cycles are compared at the end, when the largest |Q| of the history
+/// (the scale of the comparison) is known; a row is kept per cycle (`cycles.csv`).
+#[derive(Debug, Clone, Default)]
+pub struct CycleAnalysis {
+    /// The cycles closed so far, with a at each one's positive extreme.
+    rows: Vec<(CycleRow, f64)>,
+    /// The previous record.
+    previous: Option<StepRecord>,
+    /// Whether any record came after the first.
+    several: bool,
+    /// The cycle under way, from the last positive extreme.
+    open: Option<OpenCycle>,
+    /// The largest |Q| so far.
+    load_scale: f64,
+}
+
+/// A cycle under way: its first record, the sums so far and its least Q.
+#[derive(Debug, Clone)]
+struct OpenCycle {
+    first: StepRecord,
+    area: f64,
+    work: f64,
+    normal_work: f64,
+    electric_work: f64,
+    min: StepRecord,
+}
+
+impl OpenCycle {
+    fn new(first: StepRecord) -> Self {
+        // The sums start where `Iterator::sum` does.
+        let zero = std::iter::empty::<f64>().sum();
+        Self {
+            min: first.clone(),
+            first,
+            area: zero,
+            work: zero,
+            normal_work: zero,
+            electric_work: zero,
+        }
+    }
+
+    /// Add the step from `previous` to `record`.
+    fn add(&mut self, previous: &StepRecord, record: &StepRecord) {
+        self.area += 0.5 * (previous.q + record.q) * (record.displacement - previous.displacement);
+        self.work += record.dissipation;
+        self.normal_work += record.normal_work;
+        self.electric_work += record.electric_work;
+        // The first of equal minima, as `Iterator::min_by`.
+        if record.q.total_cmp(&self.min.q) == std::cmp::Ordering::Less {
+            self.min = record.clone();
+        }
+    }
+
+    /// The row of the cycle ending at `last`, numbered `cycle`.
+    fn close(self, cycle: usize, last: &StepRecord) -> CycleRow {
+        let (hi_rec, lo_rec) = (last, &self.min);
+        CycleRow {
+            cycle,
+            steps: (self.first.step, hi_rec.step),
+            loads: (self.first.q, lo_rec.q, hi_rec.q),
+            loop_area: self.area,
+            friction_work: self.work,
+            normal_work: self.normal_work,
+            electric_work: self.electric_work,
+            displacement_extremes: (hi_rec.displacement, lo_rec.displacement),
+            stick_at_max: (hi_rec.stick_lo, hi_rec.stick_hi),
+            stick_at_min: (lo_rec.stick_lo, lo_rec.stick_hi),
+            change: None,
+            compared_with: None,
+        }
+    }
+}
+
+impl CycleAnalysis {
+    /// An analysis with no records yet.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Take the next record.
+    pub fn push(&mut self, record: &StepRecord) {
+        use crate::history::Regime;
+        self.load_scale = f64::max(self.load_scale, record.q.abs());
+        if let Some(previous) = self.previous.take() {
+            // The previous record is a positive extreme when a reverse phase follows its
+            // forward phase (record 0, the end of normal loading, never is).
+            if self.several
+                && previous.regime == Regime::ForwardSlip
+                && record.regime == Regime::ReverseSlip
+            {
+                self.close_at(&previous);
+            }
+            if let Some(open) = &mut self.open {
+                open.add(&previous, record);
+            }
+            self.several = true;
+        }
+        self.previous = Some(record.clone());
+    }
+
+    /// Close the cycle under way (if any) at the positive extreme `extreme`, and open the next.
+    fn close_at(&mut self, extreme: &StepRecord) {
+        if let Some(open) = self.open.take() {
+            let row = open.close(self.rows.len() + 1, extreme);
+            self.rows.push((row, extreme.half_width));
+        }
+        self.open = Some(OpenCycle::new(extreme.clone()));
+    }
+
+    /// The cycles so far.
+    pub fn cycle_count(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// The rows and the verdict, the last record closing a cycle when it ends a forward phase.
+    pub fn finish(mut self, tolerance: f64) -> (Vec<CycleRow>, Verdict) {
+        if let Some(last) = self.previous.take()
+            && self.several
+            && last.regime == crate::history::Regime::ForwardSlip
+        {
+            self.close_at(&last);
+        }
+        let mut rows: Vec<CycleRow> = Vec::with_capacity(self.rows.len());
+        for (mut row, half_width) in self.rows {
+            compare_with_earlier(&rows, &mut row, half_width, self.load_scale);
+            rows.push(row);
+        }
+        let verdict = judge(&rows, self.load_scale, tolerance);
+        (rows, verdict)
+    }
+}
+
+/// Compare `row` with the latest earlier cycle of `rows` under the same loads (start, minimum,
+/// end of Q, within 1e−9 of `load_scale`): the previous cycle under constant amplitude, the same
+/// cycle one block earlier under a repeated variable-amplitude block. `half_width` is a at the
+/// cycle's positive extreme (the scale of the stick ends).
+fn compare_with_earlier(rows: &[CycleRow], row: &mut CycleRow, half_width: f64, load_scale: f64) {
+    let same = |a: (f64, f64, f64), b: (f64, f64, f64)| {
+        let tol = 1e-9 * load_scale;
+        (a.0 - b.0).abs() <= tol && (a.1 - b.1).abs() <= tol && (a.2 - b.2).abs() <= tol
+    };
+    if let Some(prev) = rows.iter().rev().find(|r| same(r.loads, row.loads)) {
+        let a = half_width;
+        let amp = (prev.displacement_extremes.0 - prev.displacement_extremes.1)
+            .abs()
+            .max(1e-300);
+        let energy = prev.loop_area.abs().max(1e-300);
+        let d = [
+            (row.stick_at_max.0 - prev.stick_at_max.0).abs() / a,
+            (row.stick_at_max.1 - prev.stick_at_max.1).abs() / a,
+            (row.stick_at_min.0 - prev.stick_at_min.0).abs() / a,
+            (row.stick_at_min.1 - prev.stick_at_min.1).abs() / a,
+            (row.displacement_extremes.0 - prev.displacement_extremes.0).abs() / amp,
+            (row.displacement_extremes.1 - prev.displacement_extremes.1).abs() / amp,
+            (row.loop_area - prev.loop_area).abs() / energy,
+        ];
+        row.change = Some(d.into_iter().fold(0.0, f64::max));
+        row.compared_with = Some(prev.cycle);
+    }
+}
+
+/// The verdict on the cycles `rows` (compared, [`compare_with_earlier`]), with `load_scale`
+/// the largest |Q| of the history.
+fn judge(rows: &[CycleRow], load_scale: f64, tolerance: f64) -> Verdict {
+    if rows.is_empty() {
         Verdict::NoCycles
     } else if let Some(r) = rows.iter().find(|r| {
         let amp = (r.displacement_extremes.0 - r.displacement_extremes.1).abs();
@@ -158,6 +304,72 @@ pub fn analyse_cycles(
                 last_change: rows.last().and_then(|r| r.change),
             },
         }
-    };
-    (rows, verdict)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::history::NoObserver;
+
+    /// The records of every scenario in `scenarios/` with a history, and of the default one.
+    fn scenario_records() -> Vec<(String, Vec<StepRecord>, f64)> {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+        let mut paths: Vec<_> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        paths.sort();
+        let scenarios = paths
+            .into_iter()
+            .map(|p| crate::scenario::load(&p).unwrap())
+            .chain([crate::scenario::default_scenario()]);
+        scenarios
+            .filter(|s| s.history.is_some())
+            .map(|s| {
+                let solution = crate::io::solve(&s, &mut NoObserver).unwrap();
+                (
+                    s.name.clone(),
+                    solution.records,
+                    s.raw.numerics.cycle_tolerance,
+                )
+            })
+            .collect()
+    }
+
+    fn incremental(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>, Verdict) {
+        let mut analysis = CycleAnalysis::new();
+        records.iter().for_each(|r| analysis.push(r));
+        analysis.finish(tolerance)
+    }
+
+    /// The cycle analysis taken as the records arrive gives the rows and the verdict of
+    /// [`analyse_cycles`] to the bit (compared as JSON, which writes floats exactly), on every
+    /// scenario's records (constant and variable amplitude, a partial unloading) and on every
+    /// prefix of the default run's (a history stopped at any step).
+    #[test]
+    fn the_incremental_analysis_gives_the_batch_rows_and_verdict() {
+        let json = |x: &(Vec<CycleRow>, Verdict)| serde_json::to_string(x).unwrap();
+        let all = scenario_records();
+        let mut cycles = 0;
+        for (name, records, tolerance) in &all {
+            let batch = analyse_cycles(records, *tolerance);
+            cycles += batch.0.len();
+            assert_eq!(
+                json(&incremental(records, *tolerance)),
+                json(&batch),
+                "{name}"
+            );
+        }
+        assert!(cycles >= 20, "{cycles} cycles compared");
+        let (_, default, tolerance) = all.last().unwrap();
+        for n in 0..=default.len() {
+            let prefix = &default[..n];
+            assert_eq!(
+                json(&incremental(prefix, *tolerance)),
+                json(&analyse_cycles(prefix, *tolerance)),
+                "first {n} records"
+            );
+        }
+    }
 }

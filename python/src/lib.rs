@@ -140,6 +140,22 @@ fn outcome_dict<'py>(py: Python<'py>, o: &Outcome) -> PyResult<Bound<'py, PyDict
     Ok(dict)
 }
 
+/// Every step record of a run, as the run takes them.
+#[derive(Default)]
+struct Recorder {
+    records: Vec<fretsim::history::StepRecord>,
+}
+
+impl fretsim::history::Observer for Recorder {
+    fn on_step(
+        &mut self,
+        record: &fretsim::history::StepRecord,
+        _state: fretsim::history::StateView<'_>,
+    ) {
+        self.records.push(record.clone());
+    }
+}
+
 /// Solve one scenario (JSON text); with `out`, also write the output folder that
 /// `fretsim run` writes (the same rules: a new folder or a previous fretsim output).
 fn solve_one(text: &str, label: &str, out: Option<&str>) -> Result<Outcome, Error> {
@@ -149,9 +165,11 @@ fn solve_one(text: &str, label: &str, out: Option<&str>) -> Result<Outcome, Erro
         return Ok(outcome(&scenario, &solution));
     };
     // As `fretsim run`: a failed normal loading leaves failure.json; a history that stops
-    // part-way is written and returned with its failure.
-    let result =
-        fretsim::io::run_partial(&scenario, Path::new(out), &mut fretsim::history::NoObserver)?;
+    // part-way is written and returned with its failure. The written run streams its records
+    // into `steps.csv`; Python gets them all, collected as they are taken.
+    let mut recorder = Recorder::default();
+    let mut result = fretsim::io::run_partial(&scenario, Path::new(out), &mut recorder)?;
+    result.solution.records = recorder.records;
     Ok(outcome(&scenario, &result.solution))
 }
 

@@ -77,6 +77,10 @@ pub struct RunOptions {
     pub check_phase_starts: bool,
     /// The general solver's largest element, relative to the contact half-width.
     pub general_element_size: f64,
+    /// Keep every record in the run's records ([`super::HistoryRun::records`]), or only the
+    /// last one (the observer sees each: a run that streams its records holds a bounded
+    /// number of them, however long the history).
+    pub keep_records: bool,
 }
 
 impl RunOptions {
@@ -97,6 +101,7 @@ impl RunOptions {
             slip,
             solver,
             check_phase_starts: solver == SolverChoice::Auto,
+            keep_records: true,
             general_element_size: INNER_SIZE,
         }
     }
@@ -110,6 +115,7 @@ impl RunOptions {
             solver: SolverChoice::Spectral,
             check_phase_starts: false,
             general_element_size: INNER_SIZE,
+            keep_records: true,
         }
     }
 }

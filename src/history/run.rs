@@ -20,7 +20,8 @@ use super::state::{HistoryState, HistoryStateView};
 /// A finished run: the records and the final state.
 #[derive(Debug, Clone)]
 pub struct HistoryRun {
-    /// One record per accepted step (step 0 = end of normal loading).
+    /// One record per accepted step (step 0 = end of normal loading); the last one only
+    /// without [`RunOptions::keep_records`].
     pub records: Vec<StepRecord>,
     /// The state after the last step.
     pub state: HistoryState,
@@ -29,7 +30,8 @@ pub struct HistoryRun {
 /// A failed run: what was accepted before the failure, and the failure.
 #[derive(Debug, Clone)]
 pub struct HistoryFailure {
-    /// The steps accepted before the failure.
+    /// The steps accepted before the failure (the last one only without
+    /// [`RunOptions::keep_records`]).
     pub records: Vec<StepRecord>,
     /// The state at the last accepted step.
     pub state: HistoryState,
@@ -110,8 +112,9 @@ pub fn turning_points(q: f64, points: &[LoadPoint]) -> Vec<bool> {
 }
 
 /// Walk the load points `points` from `state` as [`run_history`] does, pushing a record per
-/// step onto `records` (the observer sees each, and the state at each turning point,
-/// [`turning_points`]), and return the first failure, if any.
+/// step onto `records` (in place of the earlier ones without [`RunOptions::keep_records`]; the
+/// observer sees each, and the state at each turning point, [`turning_points`]), and return
+/// the first failure, if any.
 ///
 /// The spectral solver takes the steps while it can (`spectral_stretch`). Unless the
 /// choice is [`SolverChoice::Spectral`], a step it fails is taken by the general solver,
@@ -208,7 +211,7 @@ pub fn continue_run(
             record.electric_work = increments.electric_work - electric;
         }
         observer.on_step(&record, StateView::General(run.solver(), &run.state));
-        records.push(record);
+        keep(records, record, options.keep_records);
         if back.is_none() {
             state.general = Some(run);
         }
@@ -218,6 +221,15 @@ pub fn continue_run(
         next += 1;
     }
     None
+}
+
+/// Add `record` to `records`: after every earlier one when `all`, in place of them otherwise
+/// ([`RunOptions::keep_records`]).
+fn keep(records: &mut Vec<StepRecord>, record: StepRecord, all: bool) {
+    if !all {
+        records.clear();
+    }
+    records.push(record);
 }
 
 /// The tangential load of the state's last step.
@@ -326,7 +338,8 @@ fn spectral_stretch(
                         .recv()
                         .expect("the increments of a step do not panic")
                 });
-                records.push(finish_step(driver, *solved, increments, observer));
+                let record = finish_step(driver, *solved, increments, observer);
+                keep(records, record, options.keep_records);
             }
         };
         let mut pending: Option<Box<SolvedStep>> = None;
@@ -356,7 +369,8 @@ fn spectral_stretch(
             }
             match tried {
                 Ok(Tried::Hold(regime)) => {
-                    records.push(hold_record(driver, point, regime, observer));
+                    let record = hold_record(driver, point, regime, observer);
+                    keep(records, record, options.keep_records);
                 }
                 Ok(Tried::Slip(trial)) => {
                     let solved = Box::new(driver.commit(*trial));

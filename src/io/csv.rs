@@ -81,20 +81,51 @@ impl Table {
 /// Records per block of [`write_steps_csv`].
 const STEPS_BLOCK: usize = 4096;
 
-/// `steps.csv` written to `out` a block of records at a time (the same bytes as
-/// [`steps_table`]`(records, limit).csv()`, without holding the whole table: a long history
-/// has hundreds of thousands of steps).
-pub(crate) fn write_steps_csv(
-    records: &[StepRecord],
+/// `steps.csv` written as the records arrive, a block of [`STEPS_BLOCK`] records at a time:
+/// the header when made, the rows of each block when it fills, the rest at
+/// [`StepsCsv::finish`]: the bytes of [`steps_table`]`(records, limit).csv()`. A long history
+/// has hundreds of thousands of steps; this holds a block of them.
+pub(crate) struct StepsCsv<W: std::io::Write> {
+    writer: csv::Writer<W>,
+    block: Vec<StepRecord>,
     limit: f64,
-    out: &mut dyn std::io::Write,
-) -> std::io::Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    steps_table(&[], limit).write_header(&mut w)?;
-    for block in records.chunks(STEPS_BLOCK) {
-        steps_table(block, limit).write_rows(&mut w)?;
+}
+
+impl<W: std::io::Write> StepsCsv<W> {
+    /// Write the header to `out`; `limit` is ηP (N/m).
+    pub(crate) fn new(out: W, limit: f64) -> std::io::Result<Self> {
+        let mut writer = csv::Writer::from_writer(out);
+        steps_table(&[], limit).write_header(&mut writer)?;
+        Ok(Self {
+            writer,
+            block: Vec::with_capacity(STEPS_BLOCK),
+            limit,
+        })
     }
-    w.flush()
+
+    /// Take the next record.
+    pub(crate) fn push(&mut self, record: &StepRecord) -> std::io::Result<()> {
+        self.block.push(record.clone());
+        if self.block.len() == STEPS_BLOCK {
+            self.write_block()?;
+        }
+        Ok(())
+    }
+
+    fn write_block(&mut self) -> std::io::Result<()> {
+        steps_table(&self.block, self.limit).write_rows(&mut self.writer)?;
+        self.block.clear();
+        Ok(())
+    }
+
+    /// Write the rows not yet written and flush; the writer.
+    pub(crate) fn finish(mut self) -> std::io::Result<W> {
+        self.write_block()?;
+        self.writer.flush()?;
+        self.writer
+            .into_inner()
+            .map_err(|e| std::io::Error::other(e.to_string()))
+    }
 }
 
 fn real<T>(items: &[T], f: impl Fn(&T) -> f64) -> Column {
@@ -214,8 +245,9 @@ pub fn steps_table(records: &[StepRecord], limit: f64) -> Table {
 mod tests {
     use super::*;
 
-    /// `steps.csv` written in blocks has the bytes of the whole table's CSV, over more records
-    /// than a block (the default run's records repeated to 80 times their number).
+    /// `steps.csv` written as the records arrive, in blocks, has the bytes of the whole table's
+    /// CSV, over more records than a block (the default run's records repeated to 80 times
+    /// their number).
     #[test]
     fn steps_written_in_blocks_are_the_whole_tables_bytes() {
         let scenario = crate::scenario::default_scenario();
@@ -229,8 +261,10 @@ mod tests {
             .collect();
         assert!(records.len() > 2 * STEPS_BLOCK);
         let limit = scenario.model.friction * scenario.normal_load;
-        let mut streamed = Vec::new();
-        write_steps_csv(&records, limit, &mut streamed).unwrap();
-        assert!(streamed == steps_table(&records, limit).csv());
+        let mut csv = StepsCsv::new(Vec::new(), limit).unwrap();
+        for r in &records {
+            csv.push(r).unwrap();
+        }
+        assert!(csv.finish().unwrap() == steps_table(&records, limit).csv());
     }
 }

@@ -28,7 +28,7 @@ compile_error!(
 );
 
 use std::fs;
-use std::io::Write;
+use std::io::{Read, Seek, Write};
 use std::path::{Component, Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -413,24 +413,16 @@ impl RunFolder {
         Ok(())
     }
 
-    /// Write one file (relative, `/`-separated) into the staging folder through a buffered
-    /// writer that `write` fills.
-    pub fn write_with(
-        &mut self,
-        relative: &str,
-        write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
-    ) -> Result<(), Error> {
+    /// Create one file (relative, `/`-separated) in the staging folder, to be written through
+    /// the buffered writer returned with its path (`steps.csv`, written as the steps are taken).
+    pub fn create(&mut self, relative: &str) -> Result<(PathBuf, std::io::BufWriter<fs::File>), Error> {
         let path = self.staging.join(relative);
         if let Some(parent) = path.parent() {
             fs::create_dir_all(parent).map_err(write_err(parent))?;
         }
         let file = fs::File::create(&path).map_err(write_err(&path))?;
-        let mut buffered = std::io::BufWriter::new(file);
-        write(&mut buffered)
-            .and_then(|()| buffered.flush())
-            .map_err(write_err(&path))?;
         self.files.push(relative.to_string());
-        Ok(())
+        Ok((path, std::io::BufWriter::new(file)))
     }
 
     /// Save a checkpoint in the staging folder (`checkpoint/`, [`super::checkpoint`]):
@@ -453,13 +445,16 @@ impl RunFolder {
     }
 
     /// Claim `target` as [`Self::claim`] does, taking over the checkpoint that an
-    /// interrupted run on it left in its staging folder: its `state.json` and `records.jsonl`,
-    /// read by `read` (`None` when there is none), and kept in the new staging folder until
-    /// the next checkpoint replaces them. When `read` refuses them, nothing is touched.
+    /// interrupted run on it left in its staging folder: its `state.json` (the bytes) and
+    /// `records.jsonl` (the open file, read by `read` a line at a time, and still readable
+    /// after the claim replaced it), read by `read` (`None` when there is none), which also
+    /// says how many bytes of `records.jsonl` belong to the checkpoint. Those are kept in the
+    /// new staging folder with the state until the next checkpoint replaces it. When `read`
+    /// refuses them, nothing is touched.
     pub fn claim_resuming<T>(
         target: &Path,
         protected: &Protected,
-        read: impl FnOnce(&[u8], &[u8]) -> Result<T, Error>,
+        read: impl FnOnce(&[u8], &mut fs::File) -> Result<(T, u64), Error>,
     ) -> Result<(Self, Option<T>), Error> {
         let (parent, name) = allowed(target, protected, FolderKind::Run)?;
         let staging = parent.join(format!(".{name}.fretsim-new"));
@@ -470,7 +465,7 @@ impl RunFolder {
         let found = if staging.join(STAGING_MARKER).is_file() {
             match (
                 fs::read(dir.join("state.json")),
-                fs::read(dir.join("records.jsonl")),
+                fs::File::open(dir.join("records.jsonl")),
             ) {
                 (Ok(state), Ok(records)) => Some((state, records)),
                 _ => None,
@@ -478,15 +473,28 @@ impl RunFolder {
         } else {
             None
         };
-        let resume = match &found {
-            Some((state, records)) => Some(read(state, records)?),
-            None => None,
+        let (state, mut records, resume, bytes) = match found {
+            Some((state, mut records)) => {
+                let (resume, bytes) = read(&state, &mut records)?;
+                (state, records, resume, bytes)
+            }
+            None => {
+                let folder = Self::claim_locked(target, (parent, name), lock)?;
+                return Ok((folder, None));
+            }
         };
         let mut folder = Self::claim_locked(target, (parent, name), lock)?;
-        if let Some((state, records)) = &found {
-            folder.save_checkpoint(state, records)?;
-        }
-        Ok((folder, resume))
+        // The checkpoint's lines of the old `records.jsonl`, copied from the open file.
+        let dir = folder.staging.join(CHECKPOINT);
+        fs::create_dir_all(&dir).map_err(write_err(&dir))?;
+        let path = dir.join("records.jsonl");
+        let mut copy = fs::File::create(&path).map_err(write_err(&path))?;
+        records
+            .seek(std::io::SeekFrom::Start(0))
+            .and_then(|_| std::io::copy(&mut (&records).take(bytes), &mut copy))
+            .map_err(write_err(&path))?;
+        folder.save_checkpoint(&state, b"")?;
+        Ok((folder, Some(resume)))
     }
 
     /// The files written so far.

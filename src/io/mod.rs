@@ -15,6 +15,14 @@
 //! checkpoints a run writes as it goes, and resuming from one) and `folder` (the output
 //! folder's rules: never touch what fretsim did not write, replace a previous output
 //! atomically).
+//!
+//! A written run ([`run()`], [`run_partial`], `fretsim run`) keeps no record per step: each
+//! record goes, as it is taken, into `steps.csv`, the incremental cycle analysis
+//! ([`crate::analysis::CycleAnalysis`]), the summary's counts and the steps the history plots
+//! draw (all of a history of up to 4,096 steps, else the first and the last 2,048 cut to whole
+//! phases). Its memory does not grow with the history's length but for a row per cycle (and
+//! the turning-point states that `output.turning_point_fields = all` asks for). [`solve`]
+//! returns every record.
 
 internal! { mod checkpoint; }
 internal! { mod csv; }

@@ -3,25 +3,25 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::analysis::{CycleRow, analyse_cycles};
+use crate::analysis::{CycleAnalysis, CycleRow};
 use crate::contact::SurfacePoint;
 use crate::contact::normal::{NormalLoading, NormalOptions, solve_normal};
 use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
 use crate::error::Error;
 use crate::history::HistoryStateView;
-use crate::history::{RunOptions, SolvedState, SolverKind, StateView, StepRecord};
-use crate::io::checkpoint::{CheckpointSink, Kept, Resume, write_records, write_state};
-use crate::io::csv::{cycles_table, fields_table, write_steps_csv};
+use crate::history::{RunOptions, SolvedState, StateView, StepRecord};
+use crate::io::checkpoint::{Kept, Resume, RunSink, write_records, write_state};
+use crate::io::csv::{StepsCsv, cycles_table, fields_table};
 use crate::io::folder::{Protected, RunFolder};
-use crate::io::history_plots::history_plots;
+use crate::io::history_plots::{PlotWindow, history_plots};
 use crate::io::plots::{
     FamilyMember, PlotScales, ZoneEnds, family_plots, index_html, normal_loading_plots,
 };
 use crate::io::png::plot_files;
 use crate::io::summary::{
-    Handover, HandoverLog, Resolved, SnapshotSummary, Summary, derived, history_summary, normal_summary,
-    solver_statistics,
+    Handover, HandoverLog, RecordTally, Resolved, SnapshotSummary, Summary, derived,
+    history_summary, normal_summary, solver_statistics,
 };
 use crate::scenario::{Scenario, TurningFields};
 
@@ -46,7 +46,9 @@ pub struct Solution {
     /// The fields at the turning points that `output.turning_point_fields` asks for and at
     /// the last step.
     pub turning_fields: Vec<FieldSet>,
-    /// One record per accepted step (step 0 is the end of normal loading).
+    /// One record per accepted step (step 0 is the end of normal loading) from [`solve`];
+    /// none from [`run()`] and [`run_partial`], which write them into `steps.csv` as they are
+    /// taken (an observer given to [`run_partial`] sees each).
     pub records: Vec<crate::history::StepRecord>,
     /// The cycles of the history.
     pub cycles: Vec<CycleRow>,
@@ -55,6 +57,13 @@ pub struct Solution {
     /// The state at the last accepted step of a history that stopped part-way (written into
     /// `failure.json`).
     pub failure_state: Option<crate::history::HistoryState>,
+    /// The last accepted step.
+    pub(crate) last: Option<StepRecord>,
+    /// The steps the history plots draw.
+    pub(crate) plots: Option<PlotWindow>,
+    /// The most step records the run held at once besides [`Solution::records`] (the plots'
+    /// steps and those of the phase under way not yet in a checkpoint).
+    pub records_held: usize,
 }
 
 /// Sample points for field output: the contact and a margin of one half-width each side,
@@ -101,8 +110,12 @@ pub(crate) struct Snapshots<'a> {
     turning: TurningFields,
     /// Where checkpoints go, with the records not yet saved, the number saved, and the first
     /// error in saving one.
-    checkpoints: Option<&'a mut dyn CheckpointSink>,
+    checkpoints: Option<&'a mut dyn RunSink>,
     unsaved: Vec<StepRecord>,
+    /// What the outputs take from the records.
+    digest: Digest,
+    /// The most records held at once by the digest and the checkpoints' unsaved records.
+    held: usize,
     saved: usize,
     error: Option<Error>,
     /// Checkpoints written by this process.
@@ -142,6 +155,10 @@ impl crate::history::Observer for Snapshots<'_> {
         if self.checkpoints.is_some() {
             self.unsaved.push(record.clone());
         }
+        self.digest.push(record);
+        self.held = self
+            .held
+            .max(self.digest.records_held() + self.unsaved.len());
         self.inner.on_step(record, state);
     }
 
@@ -179,6 +196,85 @@ impl crate::history::Observer for Snapshots<'_> {
             reason: failure.failure.to_string(),
         });
         self.inner.on_handover(failure);
+    }
+}
+
+/// What the outputs take from the step records, gathered as the records arrive
+/// ([`Digest::push`] each in order, step 0 first): the summary's counts and turning points
+/// ([`RecordTally`]), the cycles ([`CycleAnalysis`]), the steps the history plots draw
+/// ([`PlotWindow`]) and, in a written run, the rows of `steps.csv`. Apart from a row per cycle,
+/// it holds a bounded number of records however long the history.
+pub(crate) struct Digest {
+    tally: RecordTally,
+    cycles: CycleAnalysis,
+    plots: PlotWindow,
+    /// `steps.csv` (its path and writer) in a written run.
+    steps: Option<(PathBuf, StepsCsv<Box<dyn std::io::Write>>)>,
+    /// The first error in writing `steps.csv`.
+    error: Option<Error>,
+}
+
+impl Digest {
+    /// A digest for a run of `scenario`, writing `steps.csv` into `steps` when given (its path
+    /// and writer).
+    fn new(
+        scenario: &Scenario,
+        steps: Option<(PathBuf, Box<dyn std::io::Write>)>,
+    ) -> Result<Self, Error> {
+        let limit = scenario.model.friction * scenario.normal_load;
+        let q_scale = scenario.history.as_ref().map_or(0.0, |h| {
+            h.points.iter().map(|p| p.1.abs()).fold(0.0, f64::max)
+        });
+        let steps = match steps {
+            Some((path, out)) => match StepsCsv::new(out, limit) {
+                Ok(csv) => Some((path, csv)),
+                Err(source) => return Err(Error::WriteOutput { path, source }),
+            },
+            None => None,
+        };
+        Ok(Self {
+            tally: RecordTally::new(SlipOptions::default().tolerance),
+            cycles: CycleAnalysis::new(),
+            plots: PlotWindow::new(q_scale),
+            steps,
+            error: None,
+        })
+    }
+
+    /// Take the next record.
+    pub(crate) fn push(&mut self, record: &StepRecord) {
+        self.tally.push(record);
+        self.cycles.push(record);
+        self.plots.push(record);
+        if let Some((path, csv)) = &mut self.steps
+            && self.error.is_none()
+            && let Err(source) = csv.push(record)
+        {
+            self.error = Some(Error::WriteOutput {
+                path: path.clone(),
+                source,
+            });
+        }
+    }
+
+    /// The records the digest holds now (the plots' steps; the tally's and the cycle
+    /// analysis's few aside): bounded, however many it took.
+    pub(crate) fn records_held(&self) -> usize {
+        self.plots.kept()
+    }
+
+    /// Finish `steps.csv`; the first error in writing it.
+    fn finish_steps(&mut self) -> Result<(), Error> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        match self.steps.take() {
+            Some((path, csv)) => csv
+                .finish()
+                .map(drop)
+                .map_err(|source| Error::WriteOutput { path, source }),
+            None => Ok(()),
+        }
     }
 }
 
@@ -237,7 +333,7 @@ pub(crate) fn solve_from<'a>(
     scenario: &'a Scenario,
     observer: &'a mut dyn crate::history::Observer,
     resume: Option<Resume>,
-    checkpoints: Option<&'a mut dyn CheckpointSink>,
+    mut checkpoints: Option<&'a mut dyn RunSink>,
 ) -> Result<Solution, Error> {
     let model = &scenario.model;
     let disc = Discretisation::new(scenario.collocation_points);
@@ -247,17 +343,38 @@ pub(crate) fn solve_from<'a>(
             failure,
         })?;
     let mut warnings: Vec<String> = gap_warning(scenario, &normal).into_iter().collect();
-    // The tangential history, if any; a failure keeps the steps already solved.
+    // The tangential history, if any; a failure keeps the steps already solved. A written run
+    // (with a sink) streams its records into the digest and `steps.csv` and keeps none.
+    let written = checkpoints.is_some();
+    let steps_file = match (&mut checkpoints, &scenario.history) {
+        (Some(sink), Some(_)) => Some(sink.create("steps.csv")?),
+        _ => None,
+    };
+    let mut digest = Digest::new(scenario, steps_file)?;
     let mut records = Vec::new();
     let mut failure = None;
     let mut failure_state = None;
     let (kept, resumed) = match resume {
         Some(Resume {
             step,
-            records,
+            mut records,
             snapshots,
             state,
-        }) => (snapshots, Some((step, records, state))),
+        }) => {
+            // The steps taken before the checkpoint, as the interrupted run's digest took them
+            // (read back one at a time; `solve` keeps them all, as it does the new ones).
+            let mut last = Vec::new();
+            let saved = records
+                .replay(|r| {
+                    digest.push(&r);
+                    if !written {
+                        last.push(r);
+                    } else {
+                        last = vec![r];
+                    }
+                })?;
+            (snapshots, Some((step, saved, last, state)))
+        }
         None => (
             Kept {
                 previous: None,
@@ -269,7 +386,7 @@ pub(crate) fn solve_from<'a>(
             None,
         ),
     };
-    let saved = resumed.as_ref().map_or(0, |(_, records, _)| records.len());
+    let saved = resumed.as_ref().map_or(0, |&(_, saved, ..)| saved);
     let mut snapshots = Snapshots {
         inner: observer,
         scenario,
@@ -277,6 +394,8 @@ pub(crate) fn solve_from<'a>(
         turning: scenario.raw.output.turning_point_fields,
         checkpoints,
         unsaved: Vec::new(),
+        digest,
+        held: 0,
         saved,
         error: None,
         written: 0,
@@ -284,17 +403,18 @@ pub(crate) fn solve_from<'a>(
     if let Some(history) = &scenario.history {
         let options = RunOptions {
             general_element_size: scenario.raw.numerics.general_element_size,
+            keep_records: !written,
             ..RunOptions::new(scenario.solver)
         };
         let run = match resumed {
             None => {
                 crate::history::run_history(model, &disc, &normal, history, options, &mut snapshots)
             }
-            Some((step, done, state)) => resume_history(
+            Some((step, _, last, state)) => resume_history(
                 model,
                 &disc,
                 history,
-                (step, done, state),
+                (step, last, state),
                 options,
                 &mut snapshots,
             ),
@@ -311,18 +431,30 @@ pub(crate) fn solve_from<'a>(
                 });
             }
         }
+        if written {
+            records.clear();
+        }
     }
     if let Some(e) = snapshots.error.take() {
         return Err(e);
     }
     let kept = snapshots.kept;
-    warnings.extend(stalled_warning(&records));
+    let records_held = snapshots.held;
+    let mut digest = snapshots.digest;
+    digest.finish_steps()?;
+    let Digest {
+        tally,
+        cycles,
+        plots,
+        ..
+    } = digest;
+    warnings.extend(stalled_warning(&tally));
     let tolerance = scenario.raw.numerics.cycle_tolerance;
-    let (cycles, verdict) = analyse_cycles(&records, tolerance);
+    let (cycles, verdict) = cycles.finish(tolerance);
     let history_summary = scenario
         .history
         .as_ref()
-        .map(|_| history_summary(&records, failure.as_ref(), &cycles, verdict, tolerance));
+        .map(|_| history_summary(&tally, failure.as_ref(), &cycles, verdict, tolerance));
     // Sampled fields: the end of normal loading, then each snapshot time reached.
     let sample = |state: &SolvedState| -> Vec<SurfacePoint> {
         let (centre, half_width) = state.contact();
@@ -338,7 +470,7 @@ pub(crate) fn solve_from<'a>(
         ends: ZoneEnds::of(&normal.state),
     }];
     let (at_snapshots, snapshot_rows) =
-        snapshot_fields(scenario, &kept.at_times, &sample, &records, &mut warnings);
+        snapshot_fields(scenario, &kept.at_times, &sample, tally.last(), &mut warnings);
     fields.extend(at_snapshots);
     let summary = Summary {
         fretsim_version: env!("CARGO_PKG_VERSION"),
@@ -351,7 +483,7 @@ pub(crate) fn solve_from<'a>(
         normal_loading: normal_summary(model, &normal),
         history: history_summary,
         snapshots: snapshot_rows,
-        solver: solver_statistics(scenario, &normal, &records, kept.handovers),
+        solver: solver_statistics(scenario, &normal, &tally, kept.handovers),
         warnings,
     };
     // Turning points and the last step, unless switched off.
@@ -375,11 +507,14 @@ pub(crate) fn solve_from<'a>(
         cycles,
         failure,
         failure_state,
+        last: tally.last().cloned(),
+        plots: scenario.history.as_ref().map(|_| plots),
+        records_held,
     })
 }
 
-/// The rest of `history` after step `step`, from `state` with the records `records` of the
-/// steps taken ([`crate::history::run_history`] from a checkpoint).
+/// The rest of `history` after step `step`, from `state` after the steps `records` (all those
+/// taken, or the last; [`crate::history::run_history`] from a checkpoint).
 fn resume_history(
     model: &crate::contact::ContactModel,
     disc: &Discretisation,
@@ -427,20 +562,14 @@ fn gap_warning(scenario: &Scenario, normal: &NormalLoading) -> Option<String> {
 }
 
 /// The warning for steps the spectral solver accepted with a residual above its tolerance.
-fn stalled_warning(records: &[StepRecord]) -> Option<String> {
+fn stalled_warning(tally: &RecordTally) -> Option<String> {
     let solver_tolerance = SlipOptions::default().tolerance;
-    let stalled: Vec<&StepRecord> = records
-        .iter()
-        .filter(|r| r.solver == SolverKind::Spectral && r.residual >= solver_tolerance)
-        .collect();
-    let worst = stalled
-        .iter()
-        .max_by(|x, y| x.residual.total_cmp(&y.residual))?;
+    let (stalled, worst) = tally.stalled();
+    let worst = worst?;
     Some(format!(
-        "{} step(s) accepted with a stalled residual above the solver tolerance {solver_tolerance:e} \
+        "{stalled} step(s) accepted with a stalled residual above the solver tolerance {solver_tolerance:e} \
          (largest {:.3e} at step {}, t = {} s): the iteration stopped improving below the \
          stall tolerance; see the residual column of steps.csv",
-        stalled.len(),
         worst.residual,
         worst.step,
         worst.t
@@ -453,7 +582,7 @@ fn snapshot_fields(
     scenario: &Scenario,
     at_times: &[Option<(StepRecord, SolvedState)>],
     sample: &dyn Fn(&SolvedState) -> Vec<SurfacePoint>,
-    records: &[StepRecord],
+    last: Option<&StepRecord>,
     warnings: &mut Vec<String>,
 ) -> (Vec<FieldSet>, Vec<SnapshotSummary>) {
     let limit = scenario.model.friction * scenario.normal_load;
@@ -464,7 +593,7 @@ fn snapshot_fields(
         let Some((rec, state)) = kept else {
             warnings.push(format!(
                 "snapshot t = {t} s was not reached (the history stopped at t = {} s); fields/{stem}.csv is not written",
-                records.last().map_or(f64::NAN, |r| r.t)
+                last.map_or(f64::NAN, |r| r.t)
             ));
             continue;
         };
@@ -502,10 +631,12 @@ pub(crate) fn write_solution(
         summary,
         fields,
         turning_fields,
-        records,
         cycles,
         failure,
         failure_state,
+        last,
+        plots,
+        ..
     } = solution;
     let limit = scenario.model.friction * scenario.normal_load;
     let scales = plot_scales(scenario, summary);
@@ -514,8 +645,8 @@ pub(crate) fn write_solution(
         "summary.json",
         &serde_json::to_vec_pretty(summary).expect("summary serialises"),
     )?;
+    // `steps.csv` is written as the steps are taken (`Digest`).
     if scenario.history.is_some() {
-        folder.write_with("steps.csv", |w| write_steps_csv(records, limit, w))?;
         folder.write("cycles.csv", &cycles_table(cycles).csv())?;
     }
     {
@@ -551,7 +682,10 @@ pub(crate) fn write_solution(
         )?;
         section(
             "Load history",
-            history_plots(records, limit, failure.is_some()),
+            plots
+                .as_ref()
+                .map(|p| history_plots(p, limit, failure.is_some()))
+                .unwrap_or_default(),
         )?;
         let instants: Vec<FamilyMember> = fields[1..]
             .iter()
@@ -563,7 +697,7 @@ pub(crate) fn write_solution(
         )?;
     }
     if let Some(e) = failure {
-        let json = failure_json(e, records.last(), failure_state.as_ref());
+        let json = failure_json(e, last.as_ref(), failure_state.as_ref());
         folder.write("failure.json", &json)?;
     }
     let mut written = folder.files().to_vec();
@@ -609,4 +743,68 @@ pub(crate) fn failure_json(
         state,
     };
     serde_json::to_vec_pretty(&body).expect("serialises")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::history::NoObserver;
+    use crate::io::history_plots::DRAWN_STEPS;
+
+    /// The default scenario with its cycle repeated `repeats` times (40 steps a cycle).
+    fn repeated_default(repeats: usize) -> Scenario {
+        let text = crate::scenario::DEFAULT_SCENARIO.replace(
+            r#""repeats": 3"#,
+            &format!(r#""repeats": {repeats}"#),
+        );
+        let raw = crate::scenario::parse(&text, Path::new("<test>")).unwrap();
+        crate::scenario::validate(raw).unwrap()
+    }
+
+    /// A written run keeps none of its records in its solution and holds at most the plots'
+    /// steps and a phase's: the same number over 120 and 180 cycles (4,810 and 7,210 steps,
+    /// both beyond the 2·`DRAWN_STEPS` the plots draw). Its `steps.csv`, `cycles.csv` and
+    /// `summary.json` are those made from every record in memory ([`solve`], with the batch
+    /// cycle analysis), and its plots say which steps they draw.
+    #[test]
+    fn a_written_run_holds_a_bounded_number_of_records() {
+        let mut held = Vec::new();
+        for repeats in [120, 180] {
+            let scenario = repeated_default(repeats);
+            let dir = tempfile::tempdir().unwrap();
+            let out = dir.path().join("run");
+            let result = run(&scenario, &out).unwrap();
+            let solution = &result.solution;
+            assert!(solution.records.is_empty());
+            assert!(
+                solution.records_held <= 2 * DRAWN_STEPS + 40,
+                "{} records held",
+                solution.records_held
+            );
+            held.push(solution.records_held);
+            if repeats > 120 {
+                continue;
+            }
+            let memory = solve(&scenario, &mut NoObserver).unwrap();
+            let steps = memory.records.len();
+            assert_eq!(steps, 40 * repeats + 10 + 1);
+            let limit = scenario.model.friction * scenario.normal_load;
+            let read = |name: &str| std::fs::read(out.join(name)).unwrap();
+            assert!(read("steps.csv") == crate::io::csv::steps_table(&memory.records, limit).csv());
+            let tolerance = scenario.raw.numerics.cycle_tolerance;
+            let (cycles, verdict) = crate::analysis::analyse_cycles(&memory.records, tolerance);
+            assert!(read("cycles.csv") == cycles_table(&cycles).csv());
+            let summary = serde_json::to_vec_pretty(&memory.summary).unwrap();
+            assert!(read("summary.json") == summary);
+            let history = memory.summary.history.as_ref().unwrap();
+            assert_eq!(
+                serde_json::to_string(&history.verdict).unwrap(),
+                serde_json::to_string(&verdict).unwrap()
+            );
+            let svg = String::from_utf8(read("plots/hysteresis.svg")).unwrap();
+            assert!(svg.contains(&format!(" of {} drawn", steps - 1)), "title");
+            assert!(svg.contains(">steps 0–"), "legend");
+        }
+        assert_eq!(held[0], held[1], "records held over 120 and 180 cycles");
+    }
 }

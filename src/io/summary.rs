@@ -9,7 +9,7 @@ use crate::analysis::{CycleRow, Verdict};
 use crate::contact::ContactModel;
 use crate::contact::normal::NormalLoading;
 use crate::halfplane::{PaperCoefficients, SurfaceCompliance, SurfaceFieldCoefficients};
-use crate::history::SolverKind;
+use crate::history::{SolverKind, StepRecord};
 use crate::scenario::{RawScenario, Scenario};
 
 /// Constants derived from the material, reported in `summary.json`.
@@ -313,44 +313,150 @@ pub struct SnapshotSummary {
     pub stick_hi: f64,
 }
 
+/// The first and the last [`LISTED`] items of a list as it grows, and how many it has: the
+/// items [`first_and_last`] keeps of the whole list.
+#[derive(Debug, Clone)]
+pub(crate) struct Listed<T> {
+    count: usize,
+    first: Vec<T>,
+    last: VecDeque<T>,
+}
+
+impl<T> Default for Listed<T> {
+    fn default() -> Self {
+        Self {
+            count: 0,
+            first: Vec::new(),
+            last: VecDeque::new(),
+        }
+    }
+}
+
+impl<T> Listed<T> {
+    /// Add an item at the end.
+    pub(crate) fn push(&mut self, item: T) {
+        self.count += 1;
+        if self.first.len() < LISTED {
+            self.first.push(item);
+        } else {
+            if self.last.len() == LISTED {
+                self.last.pop_front();
+            }
+            self.last.push_back(item);
+        }
+    }
+
+    /// The items kept, in order.
+    fn into_items(self) -> Vec<T> {
+        self.first.into_iter().chain(self.last).collect()
+    }
+}
+
+/// What `summary.json` and the warnings take from the step records, counted as they arrive
+/// ([`RecordTally::push`] each record in order, step 0 first): the number of steps, the last
+/// record, the turning points (the last step of each phase after the first loading began),
+/// the work counters and the worst checks, and the steps the spectral solver accepted at a
+/// stalled residual. Its size does not grow with the history.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct RecordTally {
+    records: usize,
+    last: Option<StepRecord>,
+    turning_points: Listed<StepRecord>,
+    newton_iterations: usize,
+    max_newton_iterations: usize,
+    residual_evaluations: usize,
+    max_residual: Option<f64>,
+    general_steps: usize,
+    worst_stick_excess: Option<f64>,
+    worst_slip_reversal: Option<f64>,
+    /// Steps of the spectral solver with a residual at or above `stall`, and the worst one.
+    stalled: usize,
+    worst_stalled: Option<StepRecord>,
+    stall: f64,
+}
+
+impl RecordTally {
+    /// A tally that counts as stalled the spectral steps with a residual of at least `stall`.
+    pub(crate) fn new(stall: f64) -> Self {
+        Self {
+            stall,
+            ..Self::default()
+        }
+    }
+
+    /// Take the next record.
+    pub(crate) fn push(&mut self, r: &StepRecord) {
+        // The largest finite value of a step after normal loading.
+        fn worst(acc: &mut Option<f64>, x: f64) {
+            if x.is_finite() {
+                *acc = Some(acc.map_or(x, |a| f64::max(a, x)));
+            }
+        }
+        if let Some(prev) = &self.last
+            && prev.phase != r.phase
+            && prev.phase > 0
+        {
+            self.turning_points.push(prev.clone());
+        }
+        if self.records > 0 {
+            self.newton_iterations += r.iterations;
+            self.max_newton_iterations = self.max_newton_iterations.max(r.iterations);
+            self.residual_evaluations += r.newton_iterations;
+            if r.solver == SolverKind::Spectral {
+                worst(&mut self.max_residual, r.residual);
+            }
+            worst(&mut self.worst_stick_excess, r.admissibility.stick_excess);
+            worst(&mut self.worst_slip_reversal, r.admissibility.slip_reversal);
+        }
+        if r.solver == SolverKind::General {
+            self.general_steps += 1;
+        }
+        if r.solver == SolverKind::Spectral && r.residual >= self.stall {
+            self.stalled += 1;
+            // The last of equal worst residuals, as `Iterator::max_by`.
+            if self
+                .worst_stalled
+                .as_ref()
+                .is_none_or(|w| r.residual.total_cmp(&w.residual).is_ge())
+            {
+                self.worst_stalled = Some(r.clone());
+            }
+        }
+        self.records += 1;
+        self.last = Some(r.clone());
+    }
+
+    /// The last record taken.
+    pub(crate) fn last(&self) -> Option<&StepRecord> {
+        self.last.as_ref()
+    }
+
+    /// How many spectral steps stalled, and the worst of them.
+    pub(crate) fn stalled(&self) -> (usize, Option<&StepRecord>) {
+        (self.stalled, self.worst_stalled.as_ref())
+    }
+}
+
 pub(crate) fn solver_statistics(
     scenario: &Scenario,
     normal: &NormalLoading,
-    records: &[crate::history::StepRecord],
+    tally: &RecordTally,
     handovers: HandoverLog,
 ) -> SolverStatistics {
-    let steps = records.iter().skip(1);
-    let max = |f: &dyn Fn(&crate::history::StepRecord) -> f64| {
-        records
-            .iter()
-            .skip(1)
-            .map(f)
-            .filter(|x| x.is_finite())
-            .reduce(f64::max)
-    };
     SolverStatistics {
         collocation_points: scenario.collocation_points,
         normal_loading_iterations: normal.iterations,
-        history_steps: records.len().saturating_sub(1),
-        newton_iterations: steps.clone().map(|r| r.iterations).sum(),
-        max_newton_iterations: steps.clone().map(|r| r.iterations).max().unwrap_or(0),
-        residual_evaluations: steps.map(|r| r.newton_iterations).sum(),
-        max_residual: max(&|r| {
-            if r.solver == SolverKind::Spectral {
-                r.residual
-            } else {
-                f64::NAN
-            }
-        }),
-        general_steps: records
-            .iter()
-            .filter(|r| r.solver == SolverKind::General)
-            .count(),
+        history_steps: tally.records.saturating_sub(1),
+        newton_iterations: tally.newton_iterations,
+        max_newton_iterations: tally.max_newton_iterations,
+        residual_evaluations: tally.residual_evaluations,
+        max_residual: tally.max_residual,
+        general_steps: tally.general_steps,
         handovers: handovers.first.into_iter().chain(handovers.last).collect(),
         handover_count: handovers.count,
         handover_reasons: handovers.reasons,
-        worst_stick_excess: max(&|r| r.admissibility.stick_excess),
-        worst_slip_reversal: max(&|r| r.admissibility.slip_reversal),
+        worst_stick_excess: tally.worst_stick_excess,
+        worst_slip_reversal: tally.worst_slip_reversal,
     }
 }
 
@@ -358,26 +464,21 @@ pub(crate) fn solver_statistics(
 /// of each phase, and the last step), the failure if the history stopped, the cycles and the
 /// verdict.
 pub(crate) fn history_summary(
-    records: &[crate::history::StepRecord],
+    tally: &RecordTally,
     failure: Option<&crate::error::Error>,
     cycles: &[CycleRow],
     verdict: Verdict,
     tolerance: f64,
 ) -> HistorySummary {
-    let turning_points: Vec<&crate::history::StepRecord> = records
-        .windows(2)
-        .filter(|w| w[0].phase != w[1].phase && w[0].phase > 0)
-        .map(|w| &w[0])
-        .chain(records.last().filter(|r| r.phase > 0))
-        .collect();
+    let mut turning_points = tally.turning_points.clone();
+    if let Some(last) = tally.last.as_ref().filter(|r| r.phase > 0) {
+        turning_points.push(last.clone());
+    }
     HistorySummary {
-        steps: records.len().saturating_sub(1),
-        phases: records.last().map_or(0, |r| r.phase),
-        turning_points: first_and_last(&turning_points)
-            .into_iter()
-            .cloned()
-            .collect(),
-        turning_point_count: turning_points.len(),
+        steps: tally.records.saturating_sub(1),
+        phases: tally.last.as_ref().map_or(0, |r| r.phase),
+        turning_point_count: turning_points.count,
+        turning_points: turning_points.into_items(),
         failure: failure.map(|e| e.to_string()),
         cycles: first_and_last(cycles),
         cycle_count: cycles.len(),

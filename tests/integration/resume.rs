@@ -72,6 +72,34 @@ fn a_run_killed_and_resumed_writes_the_uninterrupted_runs_output_byte_for_byte()
     assert_eq!(snapshot(&part), snapshot(&full));
 }
 
+/// A long run (the default contact's cycle 120 times, 4,810 steps: its plots draw the first
+/// and the last steps) killed at its 220th checkpoint (step 4,390), with a partial line
+/// appended to its checkpoint's records as a run killed between the two writes of a
+/// checkpoint leaves one; resumed and killed again, then resumed to the end: the output is
+/// the uninterrupted run's, byte for byte. The resumed runs read the records back a line at a
+/// time and keep only the checkpoint's lines.
+#[test]
+fn a_long_run_killed_twice_with_a_partial_record_resumes_byte_for_byte() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scenario = tmp.path().join("long.json");
+    let text = fretsim::scenario::DEFAULT_SCENARIO.replace(r#""repeats": 3"#, r#""repeats": 120"#);
+    std::fs::write(&scenario, text).unwrap();
+    let full = tmp.path().join("full");
+    let part = tmp.path().join("part");
+    full_run(Some(&scenario), &full);
+    killed(paused_run(Some(&scenario), &part, "checkpoint 220"));
+    let records = tmp
+        .path()
+        .join(".part.fretsim-new/checkpoint/records.jsonl");
+    let mut bytes = std::fs::read(&records).unwrap();
+    bytes.extend_from_slice(br#"{"step":4391,"t":"#);
+    std::fs::write(&records, bytes).unwrap();
+    killed(paused_run_resuming(Some(&scenario), &part, "checkpoint 2"));
+    let o = resume(Some(&scenario), &part, None);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(snapshot(&part), snapshot(&full));
+}
+
 /// Kill a run and wait for it to end (its lock is then released).
 fn killed(mut child: std::process::Child) {
     child.kill().unwrap();
