@@ -18,7 +18,7 @@
 //! # long histories (`benches/scenarios/`): 100 random reversals (PZT-4 default contact,
 //! # amplitudes uniform in 0.1–0.7 ηP, seed 7, 5 steps a reversal) and 1,000 steady cycles
 //! cargo bench --bench accelerations -- --scenario benches/scenarios/random_variable_amplitude_100.json \
-//!     --only chain_tables,fade_table_reuse --rounds 9 --spectral
+//!     --only chain_tables,recall --rounds 9 --spectral
 //! ```
 
 use std::hint::black_box;
@@ -70,13 +70,11 @@ type SwitchOff = fn(&mut Accelerations);
 /// Every speed-up on, each one off, and all off.
 fn variants() -> Vec<(String, Accelerations)> {
     let on = Accelerations::default();
-    let off: [(&str, SwitchOff); 9] = [
+    let off: [(&str, SwitchOff); 7] = [
         ("recall", |a| a.recall = false),
         ("coarse_jacobian", |a| a.coarse_jacobian = false),
         ("mixed_start_guesses", |a| a.mixed_start_guesses = false),
         ("projected_updates", |a| a.projected_updates = false),
-        ("fade_table_reuse", |a| a.fade_table_reuse = false),
-        ("lent_maps", |a| a.lent_maps = false),
         ("chain_tables", |a| a.chain_tables = false),
         ("continuation", |a| a.continuation = false),
         ("general_recall", |a| a.general_recall = false),

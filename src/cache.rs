@@ -30,11 +30,6 @@
 //! - [`with_column_sums`]: the padded sums of a column matrix's products
 //!   ([`crate::quadrature::ColumnMatrix`]), at every pass of the tangential solver's inner
 //!   iteration.
-//! - [`take_inner_maps`] / [`give_back_inner_maps`]: the inner iteration's matrices of the
-//!   fine and the coarse grid, lent to one step and given back when it ends; every
-//!   evaluation refills all of them. Allocated afresh at every step they were mapped and
-//!   zeroed page by page, about half of a recalled step at M = 512 (10 MB of matrices).
-//!   The tangential solver lends them only with `Accelerations::lent_maps`.
 //!
 //! # Scopes of the serde form
 //! [`SERDE_WRITTEN`] and [`SERDE_READ`] hold the identities of the shared values met while one
@@ -48,7 +43,6 @@ use std::thread::LocalKey;
 
 use crate::contact::rules::GradedRule;
 use crate::contact::stick_zone::ChebyshevPoints;
-use crate::contact::tangential::InnerMaps;
 use crate::transforms::Work;
 
 /// Tables of one kind built once per size for the process: `(size, table)`.
@@ -114,8 +108,6 @@ fn built_once<T: Sync + 'static>(
 thread_local! {
     static TRANSFORM_WORK: RefCell<Work> = RefCell::default();
     static COLUMN_SUMS: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
-    static INNER_MAPS: RefCell<InnerMaps> = RefCell::default();
-    static COARSE_INNER_MAPS: RefCell<InnerMaps> = RefCell::default();
 }
 
 /// `f` of this thread's transform buffers.
@@ -126,25 +118,6 @@ pub(crate) fn with_transform_work<R>(f: impl FnOnce(&mut Work) -> R) -> R {
 /// `f` of this thread's buffer of column sums.
 pub(crate) fn with_column_sums<R>(f: impl FnOnce(&mut Vec<f64>) -> R) -> R {
     COLUMN_SUMS.with_borrow_mut(f)
-}
-
-/// This thread's inner-iteration matrices of the fine grid (`coarse` false) or of the
-/// coarse one, taken until [`give_back_inner_maps`] (empty ones while they are lent).
-pub(crate) fn take_inner_maps(coarse: bool) -> InnerMaps {
-    inner_maps(coarse).take()
-}
-
-/// Give back what [`take_inner_maps`] lent.
-pub(crate) fn give_back_inner_maps(coarse: bool, maps: InnerMaps) {
-    inner_maps(coarse).set(maps);
-}
-
-fn inner_maps(coarse: bool) -> &'static LocalKey<RefCell<InnerMaps>> {
-    if coarse {
-        &COARSE_INNER_MAPS
-    } else {
-        &INNER_MAPS
-    }
 }
 
 thread_local! {

@@ -6,7 +6,6 @@
 
 use super::StickZone;
 use super::rules::{FADE_RULE_NODES, graded_rule_with};
-use super::stick_zone::FADE_TABLE_REUSE;
 
 /// An earlier stick zone's correction carried into a new zone, faded out smoothly where the
 /// new zone ends inside it: `χ(x) q̃_E(x)` with `χ` rising from 0 at `ramp_lo.0` to 1 at
@@ -14,8 +13,7 @@ use super::stick_zone::FADE_TABLE_REUSE;
 /// The memory inside the new zone has square-root kinks at the old zone's ends, which the old
 /// correction reproduces exactly; the fade only matters near the new ends, where q̃ must vanish.
 ///
-/// Written as plain data: the fade table as the ramps its nodes were built for (its own, or
-/// those of the link it was taken from, [`Inherited::reusing_table_of`]), rebuilt on reading.
+/// Written as plain data: the fade table as whether it was built, rebuilt on reading.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 #[serde(from = "InheritedData")]
 pub struct Inherited {
@@ -27,16 +25,16 @@ pub struct Inherited {
     /// Right ramp `(start, end)`.
     pub ramp_hi: Option<(f64, f64)>,
     /// Quadrature table of the fade integral, built on first use.
-    #[serde(serialize_with = "table_ramps")]
+    #[serde(serialize_with = "table_built")]
     table: std::sync::OnceLock<FadeTable>,
 }
 
-/// The ramps a built fade table's nodes were placed for (`None` when not built).
-fn table_ramps<S: serde::Serializer>(
+/// Whether the fade table was built.
+fn table_built<S: serde::Serializer>(
     table: &std::sync::OnceLock<FadeTable>,
     serializer: S,
 ) -> Result<S::Ok, S::Error> {
-    serde::Serialize::serialize(&table.get().map(|t| t.ramps), serializer)
+    serde::Serialize::serialize(&table.get().is_some(), serializer)
 }
 
 /// An [`Inherited`] as written.
@@ -46,24 +44,28 @@ struct InheritedData {
     zone: std::sync::Arc<StickZone>,
     ramp_lo: Option<(f64, f64)>,
     ramp_hi: Option<(f64, f64)>,
-    table: Option<[Option<(f64, f64)>; 2]>,
+    table: TableWritten,
+}
+
+/// How a fade table was written: whether it was built, or (an earlier form) the ramps its
+/// nodes were placed for, `null` when not built.
+#[derive(serde::Deserialize)]
+#[serde(untagged)]
+enum TableWritten {
+    Built(bool),
+    Ramps(Option<[Option<(f64, f64)>; 2]>),
 }
 
 impl From<InheritedData> for Inherited {
     fn from(d: InheritedData) -> Self {
         let link = Self::new(d.zone, d.ramp_lo, d.ramp_hi);
-        match d.table {
-            None => link,
-            Some([lo, hi]) if lo == link.ramp_lo && hi == link.ramp_hi => {
-                link.table();
-                link
-            }
-            Some([lo, hi]) => {
-                let built = Self::new(link.zone.clone(), lo, hi);
-                built.table();
-                link.with_nodes_of(&built)
-            }
+        if matches!(
+            d.table,
+            TableWritten::Built(true) | TableWritten::Ramps(Some(_))
+        ) {
+            link.table();
         }
+        link
     }
 }
 
@@ -76,14 +78,11 @@ struct FadeTable {
     all: Vec<(f64, f64, f64)>,
     not_one: Vec<(f64, f64, f64)>,
     not_zero: Vec<(f64, f64, f64)>,
-    /// The ramps `(ramp_lo, ramp_hi)` whose points end the pieces of the nodes.
-    ramps: [Option<(f64, f64)>; 2],
 }
 
 impl FadeTable {
-    /// The table of the nodes `(t, w q̃_E(t), χ(t))` in increasing t, on pieces ended by
-    /// `ramps`' points.
-    fn new(all: Vec<(f64, f64, f64)>, ramps: [Option<(f64, f64)>; 2]) -> Self {
+    /// The table of the nodes `(t, w q̃_E(t), χ(t))` in increasing t.
+    fn new(all: Vec<(f64, f64, f64)>) -> Self {
         // `FadeSums` finds the nodes near a point by bisection.
         debug_assert!(all.is_sorted_by(|a, b| a.0 <= b.0), "nodes in increasing t");
         let except = |v: f64| {
@@ -96,7 +95,6 @@ impl FadeTable {
             not_one: except(1.0),
             not_zero: except(0.0),
             all,
-            ramps,
         }
     }
 
@@ -339,54 +337,8 @@ impl Inherited {
                 .zip(&values)
                 .map(|((&t, &w), &q)| (t, w * q, self.chi(t)))
                 .collect();
-            FadeTable::new(all, [self.ramp_lo, self.ramp_hi])
+            FadeTable::new(all)
         })
-    }
-
-    /// This link with the nodes and `w q̃_E` of `built`'s fade table (χ at the nodes its own),
-    /// when `built` fades the same zone on the same sides by ramps whose points lie within
-    /// `FADE_TABLE_REUSE` of a ramp's length of this link's, and has its table. A step's
-    /// evaluations near convergence move the ramps by far less (and the coarse grid's first
-    /// evaluation, at the fine grid's first iterate, not at all), while the table's values,
-    /// sums of `M` terms at a few hundred points, are a noticeable part of an evaluation.
-    /// The pieces then end up to that distance from the ramps' ends, where χ has a jump in its
-    /// third derivative; the transform changes by about `2.4e−6 (δ/r)²` of its largest value
-    /// (δ the distance, r the ramp's length; measured from δ/r = 9e−5 to 1e−3, test
-    /// `a_fade_table_is_reused_for_ramps_that_hardly_moved`), round-off at the largest reuse.
-    pub fn reusing_table_of(self, built: &Inherited) -> Self {
-        let near = |a: Option<(f64, f64)>, b: Option<(f64, f64)>| match (a, b) {
-            (None, None) => true,
-            (Some(a), Some(b)) => {
-                let slack = FADE_TABLE_REUSE * (a.1 - a.0);
-                (a.0 - b.0).abs() <= slack && (a.1 - b.1).abs() <= slack
-            }
-            _ => false,
-        };
-        let Some(table) = built.table.get() else {
-            return self;
-        };
-        let [lo, hi] = table.ramps;
-        if !std::sync::Arc::ptr_eq(&self.zone, &built.zone)
-            || !self.faded()
-            || !near(self.ramp_lo, lo)
-            || !near(self.ramp_hi, hi)
-        {
-            return self;
-        }
-        self.with_nodes_of(built)
-    }
-
-    /// This link with the nodes and `w q̃_E` of `built`'s fade table, which must be built.
-    fn with_nodes_of(self, built: &Inherited) -> Self {
-        let table = built.table.get().expect("a built table");
-        let all = table
-            .all
-            .iter()
-            .map(|&(t, wq, _)| (t, wq, self.chi(t)))
-            .collect();
-        // A fresh link's table is empty, so the set cannot fail.
-        let _ = self.table.set(FadeTable::new(all, table.ramps));
-        self
     }
 
     /// The fade factor χ(x).
@@ -612,68 +564,7 @@ pub struct RememberedRoot {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::alternating_series;
     use super::*;
-
-    /// A link whose ramps moved by up to `FADE_TABLE_REUSE` of their length from those of a
-    /// link with a built table takes its nodes, and its transform and integral agree with a
-    /// fresh table's to round-off; a larger move, another zone or another side builds its own.
-    #[test]
-    fn a_fade_table_is_reused_for_ramps_that_hardly_moved() {
-        let base = std::sync::Arc::new(StickZone::new(
-            -0.95,
-            0.95,
-            alternating_series(64, 1.0),
-            -0.3,
-        ));
-        base.tabulate(96);
-        let link = |shift: f64| {
-            Inherited::new(
-                base.clone(),
-                Some((-0.8 + shift, -0.55 + shift)),
-                Some((0.1 - shift, 0.4 - shift)),
-            )
-        };
-        let built = link(0.0);
-        let points: Vec<f64> = (0..=300)
-            .map(|i| -1.2 + 2.4 * f64::from(i) / 300.0)
-            .collect();
-        built.cauchy_into(&points, &mut Vec::new());
-        // 0.9 of the largest move (the ramps are 0.25 and 0.3 long).
-        let (reused, fresh) = (
-            link(0.9e-5 * 0.25).reusing_table_of(&built),
-            link(0.9e-5 * 0.25),
-        );
-        assert!(reused.table.get().is_some() && fresh.table.get().is_none());
-        let (mut a, mut b) = (Vec::new(), Vec::new());
-        reused.cauchy_into(&points, &mut a);
-        fresh.cauchy_into(&points, &mut b);
-        let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let worst = a
-            .iter()
-            .zip(&b)
-            .map(|(x, y)| (x - y).abs())
-            .fold(0.0, f64::max)
-            / scale;
-        // Measured 3.7e−15 at this move (2.4e−15 at 1e−10 of the ramp, round-off), growing
-        // like the move squared beyond: 2.8e−14 at 9e−5, 2.1e−13 at 3e−4, 2.4e−12 at 1e−3
-        // (the pieces end that far from the jumps in χ'''). The bound is 1e−14.
-        assert!(worst < 1e-14, "transform {worst:e}");
-        assert!((reused.integral() - fresh.integral()).abs() < 1e-14 * fresh.integral().abs());
-        let other = std::sync::Arc::new(StickZone::new(
-            -0.95,
-            0.95,
-            alternating_series(64, 1.0),
-            -0.3,
-        ));
-        for not in [
-            link(2e-5 * 0.25),
-            Inherited::new(other, built.ramp_lo, built.ramp_hi),
-            Inherited::new(base.clone(), None, built.ramp_hi),
-        ] {
-            assert!(not.reusing_table_of(&built).table.get().is_none());
-        }
-    }
 
     /// The fade sums in SIMD lanes are the one-point sums to the bit, with points that lie on
     /// a node, within `tiny` of one, within twice `tiny` (the masked groups) and elsewhere, in

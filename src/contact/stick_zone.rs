@@ -281,10 +281,6 @@ impl Serialize for TableCache {
     }
 }
 
-/// The largest move of a fade ramp's points, relative to its length, over which an evaluation
-/// reuses a fade table built for the earlier ramps ([`Inherited::reusing_table_of`]).
-pub(super) const FADE_TABLE_REUSE: f64 = 1e-5;
-
 /// Collocation points a fade ramp over a short overlap must hold ([`StickZone::inheritance_for`]):
 /// enough for the series to absorb the ramp's shape. At M = 48 a quarter-overlap ramp with about
 /// five points made steps worse than leaving the remembered kink to the series.

@@ -302,10 +302,10 @@ fn resultants(
     out
 }
 
-/// Tolerances of the resultants (∫σzz + P, ∫σxz + Q relative to P; ∫Dz + Γ relative to Γ):
-/// measured at most 4.2e−14, 6.4e−14 and 8.5e−12 (the last is how well the state's charge
-/// series integrates to its Γ; the x-integration, 1600 nodes, converged: 400 gave 4e−10 at
-/// z = 0.05 a).
+/// Tolerances of the resultants (∫σzz + P, ∫σxz + Q relative to P; ∫Dz + Γ relative to Γ)
+/// of the quadrature across the line: measured at most 4.2e−14, 6.4e−14 and 8.5e−12 (the
+/// last is how well the state's charge series integrates to its Γ; the x-integration, 1600
+/// nodes, converged: 400 gave 4e−10 at z = 0.05 a).
 const RESULTANT_TOLERANCES: [f64; 3] = [2e-13, 2e-13, 3e-11];
 
 #[test]
@@ -314,6 +314,10 @@ fn equilibrium_resultants_at_every_depth_equal_the_loads() {
     // default states and McEwen's contact.
     let (model, normal, peak) = default_states();
     let kernel = SubsurfaceKernel::try_new(&model.material).unwrap();
+    // A solved state's ∫q equals Q only to the tangential solver's tolerance on its force
+    // residual, (∫q − Q)/(ηP): the x-resultant's bound adds η times that tolerance.
+    let mut tolerances = RESULTANT_TOLERANCES;
+    tolerances[1] += model.friction * crate::contact::SlipOptions::default().tolerance;
     for state in [&normal, &peak] {
         let loads = SurfaceLoads::of_state(state, DEFAULT_PANELS_PER_HALF).unwrap();
         let a = state.half_width;
@@ -326,7 +330,7 @@ fn equilibrium_resultants_at_every_depth_equal_the_loads() {
                 (dz + charge).abs() / charge,
             ];
             println!("z = {z:e}: {}", sci(&errors));
-            for (e, tol) in errors.iter().zip(RESULTANT_TOLERANCES) {
+            for (e, tol) in errors.iter().zip(tolerances) {
                 assert!(*e < tol, "z = {z:e}: {}", sci(&errors));
             }
         }

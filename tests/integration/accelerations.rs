@@ -130,37 +130,6 @@ fn the_fast_path_reaches_the_reference_states() {
     assert!(fast_evaluations < reference_evaluations);
 }
 
-/// The speed-up said to change no bit (`lent_maps`) changes no bit of a run.
-#[test]
-fn lent_maps_change_no_bit() {
-    let fast = default_run(Accelerations::default(), ZoneTables::default());
-    let without = default_run(
-        Accelerations {
-            lent_maps: false,
-            ..Accelerations::default()
-        },
-        ZoneTables::default(),
-    );
-    let bits = |records: &[StepRecord]| -> Vec<[u64; 6]> {
-        records
-            .iter()
-            .map(|r| {
-                [
-                    r.stick_lo,
-                    r.stick_hi,
-                    r.half_width,
-                    r.eccentricity,
-                    r.displacement,
-                    r.dissipation,
-                ]
-                .map(f64::to_bits)
-            })
-            .collect()
-    };
-    assert!(bits(&fast) == bits(&without));
-    assert_eq!(evaluations(&fast), evaluations(&without));
-}
-
 /// The default options are the fast path, and `Accelerations::none` switches every speed-up
 /// off.
 #[test]
@@ -175,8 +144,6 @@ fn the_default_options_are_the_fast_path() {
             || none.coarse_jacobian
             || none.mixed_start_guesses
             || none.projected_updates
-            || none.fade_table_reuse
-            || none.lent_maps
             || none.chain_tables
             || none.continuation
             || none.general_recall)

@@ -39,16 +39,6 @@ pub struct Accelerations {
     /// the attempt's earlier step directions. The states are the same to the tolerance; the
     /// steps take fewer residual evaluations.
     pub projected_updates: bool,
-    /// Let an evaluation take the fade table of the step's last inherited link when its ramps
-    /// moved by at most `FADE_TABLE_REUSE` of their length
-    /// ([`crate::contact::Inherited::reusing_table_of`]), instead of building its own. The
-    /// transform changes by about `2.4e−6 (δ/r)²` of its largest value (δ the ramps' move,
-    /// r their length), round-off at the largest move it accepts.
-    pub fade_table_reuse: bool,
-    /// Lend each thread's inner-iteration matrices from step to step (`LentMaps`, kept in
-    /// `crate::cache`) instead of allocating them at every step. Bit-identical: every
-    /// evaluation refills all of them.
-    pub lent_maps: bool,
     /// Let the stick zones the solver accepts tabulate `H'q̃` and q̃ piecewise when they
     /// begin a phase ([`StickZone::tabulate`], which the history driver calls on the turning
     /// state), instead of summing their chains at every evaluation. The zone of normal
@@ -79,8 +69,6 @@ impl Default for Accelerations {
             coarse_jacobian: true,
             mixed_start_guesses: true,
             projected_updates: true,
-            fade_table_reuse: true,
-            lent_maps: true,
             chain_tables: true,
             continuation: true,
             general_recall: true,
@@ -96,8 +84,6 @@ impl Accelerations {
             coarse_jacobian: false,
             mixed_start_guesses: false,
             projected_updates: false,
-            fade_table_reuse: false,
-            lent_maps: false,
             chain_tables: false,
             continuation: false,
             general_recall: false,

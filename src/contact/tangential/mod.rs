@@ -153,13 +153,11 @@ mod inner;
 mod kinks;
 mod linalg;
 mod residual;
-mod reuse;
 mod search;
 
 pub use accelerations::Accelerations;
 #[cfg(feature = "internals")]
 pub use checks::assess_step;
-pub(crate) use inner::InnerMaps;
 pub use search::solve_slip;
 
 use residual::Geometry;
@@ -431,7 +429,7 @@ mod tests {
     use super::residual::StepProblem;
     use super::*;
     use crate::contact::pressure::Discretisation;
-    use crate::contact::{Inherited, StickZone};
+    use crate::contact::StickZone;
 
     /// One load step of scenario `sc` by the driver (`advance`, default options).
     pub(super) fn advance_driver(
@@ -460,7 +458,6 @@ mod tests {
         driver: &'a crate::history::DriverState,
         base: Option<&'a Arc<StickZone>>,
         maps: &'a RefCell<InnerMaps>,
-        last_link: &'a RefCell<Option<Arc<Inherited>>>,
     ) -> StepProblem<'a> {
         StepProblem {
             model: &sc.model,
@@ -471,7 +468,6 @@ mod tests {
             normal_load: sc.normal_load,
             tangential_load: driver.state.tangential_load,
             scratch: maps,
-            last_link,
             accelerations: Accelerations::default(),
         }
     }

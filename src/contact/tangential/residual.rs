@@ -68,11 +68,7 @@ pub(super) struct StepProblem<'a> {
     /// The last evaluation's [`InnerMaps`], whose matrices the next evaluation refills (one
     /// for all the attempts of a step).
     pub(super) scratch: &'a RefCell<InnerMaps>,
-    /// The inherited link of the last evaluation, whose fade table the next evaluation reuses
-    /// when its ramps have hardly moved ([`Inherited::reusing_table_of`]; one for all the
-    /// attempts of a step, on both grids).
-    pub(super) last_link: &'a RefCell<Option<Arc<Inherited>>>,
-    /// The speed-ups in use (`fade_table_reuse`, the accepted zones' tables).
+    /// The speed-ups in use (the accepted zones' tables).
     pub(super) accelerations: Accelerations,
 }
 
@@ -93,33 +89,14 @@ impl StepProblem<'_> {
         guess: &ContactState,
         inner_tolerance: f64,
     ) -> Result<([f64; 4], ContactState, bool), SolveFailure> {
-        let inherited = self.inherited_link(g);
-        let evaluated = self.evaluate_with(g, guess, inherited.clone(), inner_tolerance);
-        if inherited.is_some() {
-            *self.last_link.borrow_mut() = inherited;
-        }
-        evaluated
+        self.evaluate_with(g, guess, self.inherited_link(g), inner_tolerance)
     }
 
     /// The base zone's inherited correction at the stick ends of `g` (`None` without a base
-    /// zone), with the fade table of the step's last link when its ramps have hardly moved
-    /// ([`Inherited::reusing_table_of`]). The reuse saves the table's sums of M terms at a few
-    /// hundred points, a noticeable part of an evaluation; it changes the transform by about
-    /// `2.4e−6 (δ/r)²` of its largest value (δ the ramps' move, r their length), round-off at
-    /// the largest move it accepts.
+    /// zone).
     fn inherited_link(&self, g: &Geometry) -> Option<Arc<Inherited>> {
         self.base
             .and_then(|b| b.inheritance_for(g.lo, g.hi, self.disc.nodes()))
-            .map(|link| {
-                let last = self.last_link.borrow();
-                match (Arc::try_unwrap(link), last.as_deref()) {
-                    (Ok(link), Some(built)) if self.accelerations.fade_table_reuse => {
-                        Arc::new(link.reusing_table_of(built))
-                    }
-                    (Ok(link), _) => Arc::new(link),
-                    (Err(shared), _) => shared,
-                }
-            })
     }
 
     /// As [`Self::evaluate`], with the inherited correction chosen by the caller (the

@@ -19,7 +19,6 @@ use super::residual::{
     Geometry, INNER_TOLERANCE, JACOBIAN_INNER_TOLERANCE, LOOSEST_INNER_TOLERANCE, StepProblem,
     inner_tolerance,
 };
-use super::reuse::LentMaps;
 use super::{
     PhaseStart, Recalled, SlipOptions, SlipPattern, SlipStep, StepAdmissibility, WarmStart,
 };
@@ -91,8 +90,7 @@ pub fn solve_slip(
         plan.insert(at, entry);
     }
     let mut attempts = Attempts::default();
-    let scratch = LentMaps::lend(false, options.accelerations.lent_maps);
-    let last_link = RefCell::new(None);
+    let scratch = RefCell::default();
     let problem_for = |signs: (f64, f64)| StepProblem {
         model,
         disc,
@@ -101,8 +99,7 @@ pub fn solve_slip(
         signs,
         normal_load: start.normal_load,
         tangential_load,
-        scratch: &scratch.0,
-        last_link: &last_link,
+        scratch: &scratch,
         accelerations: options.accelerations,
     };
     if let Some(step) = recalled.and_then(|r| recall(&problem_for, start, r, options)) {
@@ -394,10 +391,10 @@ fn coarse_jacobian(
     g: &Geometry,
     guess: &ContactState,
 ) -> Option<[[f64; 4]; 4]> {
-    let maps = LentMaps::lend(true, problem.accelerations.lent_maps);
+    let maps = RefCell::default();
     let coarse = StepProblem {
         disc: problem.disc.coarse()?,
-        scratch: &maps.0,
+        scratch: &maps,
         ..*problem
     };
     let (r, state, _) = coarse.evaluate(g, guess, INNER_TOLERANCE).ok()?;
@@ -861,14 +858,12 @@ mod tests {
                 solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
             let mut driver = DriverState::after_normal_loading(&normal);
             let base = normal.state.traction.stick.clone().map(Arc::new);
-            let maps = LentMaps::lend(false, true);
+            let maps = RefCell::default();
             // The fine Jacobian at the state the driver has reached, and the step's problem.
             let at_state = |driver: &DriverState| {
                 let state = &driver.state;
                 let g = Geometry::of(state).expect("slip state");
-                let last_link = RefCell::new(None);
-                let problem =
-                    forward_problem(&sc, &disc, driver, base.as_ref(), &maps.0, &last_link);
+                let problem = forward_problem(&sc, &disc, driver, base.as_ref(), &maps);
                 let (r, solved, _) = problem.evaluate(&g, state, INNER_TOLERANCE).unwrap();
                 // The state is a converged one: its residual again below the solver's tolerance.
                 let tolerance = SlipOptions::default().tolerance;
