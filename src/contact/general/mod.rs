@@ -63,6 +63,21 @@
 //! −1e−9 of the profile height at the contact end); stop when neither happens. A set met
 //! before ends the search with the last set that had `p ≥ 0`.
 //!
+//! **Smooth contact ends.** When neither happens, the contact is then extended element by
+//! element into its exterior neighbours for as long as the solution on the larger set keeps
+//! `p ≥ 0` everywhere (and the gaps are checked again): C is the *largest* set with `p ≥ 0`
+//! and no negative gap. For an elastic half-plane that set is the only one (the kernel is
+//! positive definite), so nothing changes. Under a conducting punch with `Γ < Γ1 = kP` it is
+//! not: the constant-potential charge `(Γ − kP)/(π√(a² − x²))` is negative and opens the gap
+//! just outside each end like `+√(x − a)`, so a pressure with a positive inverse-square-root
+//! end term, up to `A = −y23(Γ − kP)/Y*`, also leaves a non-negative gap (PZT-4, P = 2000 N/m,
+//! Γ = 2e−7 C/m: A up to 285 N/m, any half-width from 0.926 to 1 times the smooth one). The
+//! search above stops at the first such set it meets, so an advancing end stayed where it was
+//! and the pressure piled up there (frictionless proportional loading ended at 0.927 a with
+//! 0.9 p0 at the end elements; under tangential load the contact did not translate). The
+//! model's closure is the seed paper's: p bounded, and for a smooth punch zero, at both ends,
+//! which is A = 0, the largest of those sets, as the spectral solver assumes.
+//!
 //! # Tangential subproblem (p and g fixed)
 //! With `U⁰` the element integrals of the previous step's `ux` (the slip reference) and
 //! `c = Ux(p, g) − U⁰`, the tractions minimise the incremental complementary energy

@@ -49,6 +49,7 @@ pub(super) fn solve(
     let n = input.mesh.len();
     let mut seen: HashSet<Vec<bool>> = HashSet::new();
     let mut last_admissible: Option<NormalSolution> = None;
+    let mut extensions = 0;
     for iteration in 1..=4 * n + 10 {
         if !contact.iter().any(|&c| c) {
             return Err(SolveFailure::NoAdmissibleState {
@@ -80,6 +81,18 @@ pub(super) fn solve(
             .fold(0.0, f64::max);
         let tol = 1e-9 * scale;
         let penetrating: Vec<usize> = (0..n).filter(|&i| !contact[i] && gaps[i] < -tol).collect();
+        if penetrating.is_empty() && input.grow && extensions < MAX_EXTENSIONS {
+            // p ≥ 0 and gap ≥ 0 hold; make the contact the largest such set (module docs of
+            // `super`, "smooth contact ends"), then check the gaps again.
+            extensions += 1;
+            let grown = extend(input, &sol, work)?;
+            if grown.contact != sol.contact {
+                seen.insert(contact.clone());
+                contact = grown.contact;
+                last_admissible = Some(sol);
+                continue;
+            }
+        }
         if penetrating.is_empty() || !input.grow {
             return Ok(sol);
         }
@@ -98,6 +111,43 @@ pub(super) fn solve(
         iterations: 4 * n + 10,
         residual: f64::NAN,
     })
+}
+
+/// How many times one call of [`solve`] extends the contact ends (each extension runs until
+/// no neighbour can join; a second one only follows a set that the gap check changed).
+const MAX_EXTENSIONS: usize = 2;
+
+/// The contact extended element by element into its exterior neighbours while the solution on
+/// the larger set keeps `p ≥ 0` on every contact element (module docs of `super`, "smooth
+/// contact ends"): a neighbour whose trial gives a negative pressure anywhere is not tried
+/// again in this call.
+fn extend(
+    input: &NormalInput,
+    sol: &NormalSolution,
+    work: &mut Workspace,
+) -> Result<NormalSolution, SolveFailure> {
+    let n = input.mesh.len();
+    let mut best = sol.clone();
+    let mut rejected = vec![false; n];
+    loop {
+        let c = &best.contact;
+        let Some(next) = (0..n).find(|&i| {
+            !c[i] && !rejected[i] && ((i > 0 && c[i - 1]) || (i + 1 < n && c[i + 1]))
+        }) else {
+            return Ok(best);
+        };
+        let mut trial = c.clone();
+        trial[next] = true;
+        let candidate = solve_on(input, &trial, work)?;
+        if (0..n).all(|i| !trial[i] || candidate.pressure[i] >= 0.0) {
+            best = NormalSolution {
+                iterations: best.iterations + 1,
+                ..candidate
+            };
+        } else {
+            rejected[next] = true;
+        }
+    }
 }
 
 /// Mean gap per element, `(1/Δi)∫(uz − δz + x²/2R)`, for every element.
