@@ -358,18 +358,7 @@ impl SurfaceFieldCoefficients {
                         e15_over_c44: 0.0,
                     };
                 }
-                let lambda = 2.0 * mu * nu / (1.0 - 2.0 * nu);
-                PiezoConstants {
-                    c11: lambda + 2.0 * mu,
-                    c13: lambda,
-                    c33: lambda + 2.0 * mu,
-                    c44: mu,
-                    e31: 0.0,
-                    e33: 0.0,
-                    e15: 0.0,
-                    eps11: 1.0,
-                    eps33: 1.0,
-                }
+                PiezoConstants::uncoupled_isotropic(mu, nu, 1.0, 1.0)
             }
         };
         let den = c.e33 * c.e33 + c.c33 * c.eps33;

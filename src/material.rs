@@ -248,8 +248,8 @@ fn check_poisson(issues: &mut Vec<Issue>, path: &str, nu: f64) {
 impl PiezoConstants {
     /// An isotropic elastic solid (shear modulus μ, Poisson's ratio ν) written as
     /// piezoelectric constants without coupling (e = 0), with permittivities ε11, ε33: the
-    /// degenerate case of the Stroh formalism that the tests check the kernels against.
-    #[cfg(test)]
+    /// degenerate case of the Stroh formalism (the elastic half-plane's compliance, and the
+    /// isotropic solid the tests check the kernels against).
     pub(crate) fn uncoupled_isotropic(mu: f64, nu: f64, eps11: f64, eps33: f64) -> Self {
         let lambda = 2.0 * mu * nu / (1.0 - 2.0 * nu);
         Self {
