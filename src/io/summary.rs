@@ -217,16 +217,14 @@ fn first_and_last<T: Clone>(items: &[T]) -> Vec<T> {
 /// every checkpoint).
 #[derive(Debug, Clone, Default, Serialize, serde::Deserialize)]
 pub struct HandoverLog {
-    count: usize,
+    #[serde(flatten)]
+    listed: Listed<Handover>,
     reasons: BTreeMap<String, usize>,
-    first: Vec<Handover>,
-    last: VecDeque<Handover>,
 }
 
 impl HandoverLog {
     /// Log a handover.
     pub fn push(&mut self, handover: Handover) {
-        self.count += 1;
         let kind = reason_kind(&handover.reason);
         let key = if self.reasons.contains_key(&kind) || self.reasons.len() < REASON_KINDS {
             kind
@@ -234,14 +232,7 @@ impl HandoverLog {
             "other".to_string()
         };
         *self.reasons.entry(key).or_insert(0) += 1;
-        if self.first.len() < LISTED {
-            self.first.push(handover);
-        } else {
-            if self.last.len() == LISTED {
-                self.last.pop_front();
-            }
-            self.last.push_back(handover);
-        }
+        self.listed.push(handover);
     }
 }
 
@@ -315,7 +306,7 @@ pub struct SnapshotSummary {
 
 /// The first and the last [`LISTED`] items of a list as it grows, and how many it has: the
 /// items [`first_and_last`] keeps of the whole list.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub(crate) struct Listed<T> {
     count: usize,
     first: Vec<T>,
@@ -452,8 +443,8 @@ pub(crate) fn solver_statistics(
         residual_evaluations: tally.residual_evaluations,
         max_residual: tally.max_residual,
         general_steps: tally.general_steps,
-        handovers: handovers.first.into_iter().chain(handovers.last).collect(),
-        handover_count: handovers.count,
+        handover_count: handovers.listed.count,
+        handovers: handovers.listed.into_items(),
         handover_reasons: handovers.reasons,
         worst_stick_excess: tally.worst_stick_excess,
         worst_slip_reversal: tally.worst_slip_reversal,
@@ -526,8 +517,14 @@ mod tests {
         for step in 0..n {
             log.push(handover(step, &format!("residual {step}e-3 stalled")));
         }
-        assert_eq!(log.count, n);
-        let listed: Vec<usize> = log.first.iter().chain(&log.last).map(|h| h.step).collect();
+        assert_eq!(log.listed.count, n);
+        let listed: Vec<usize> = log
+            .listed
+            .clone()
+            .into_items()
+            .iter()
+            .map(|h| h.step)
+            .collect();
         assert_eq!(listed, (0..LISTED).chain(n - LISTED..n).collect::<Vec<_>>());
         assert_eq!(log.reasons.len(), 1);
         assert_eq!(log.reasons["residual # stalled"], n);
@@ -536,7 +533,7 @@ mod tests {
         }
         assert_eq!(log.reasons.len(), REASON_KINDS + 1);
         assert_eq!(log.reasons["other"], REASON_KINDS + 1);
-        assert_eq!(log.count, n + 2 * REASON_KINDS);
+        assert_eq!(log.listed.count, n + 2 * REASON_KINDS);
     }
 
     /// Lists of at most 2·LISTED items are kept whole; longer ones lose their middle.
