@@ -28,7 +28,7 @@ use fretsim::contact::ZoneTables;
 use fretsim::contact::normal::{NormalOptions, solve_normal};
 use fretsim::contact::pressure::Discretisation;
 use fretsim::contact::tangential::Accelerations;
-use fretsim::history::{NoObserver, RunOptions, StepRecord, run_history};
+use fretsim::history::{NoObserver, NormalEnd, RunOptions, StepRecord, run_history};
 
 /// The command's allocator (`src/main.rs`), so that the bench times what a run does.
 #[cfg(feature = "mimalloc")]
@@ -51,7 +51,9 @@ fn default_run(
         },
         ..NormalOptions::default()
     };
-    let normal = solve_normal(&sc.model, &disc, sc.normal_load, normal_options).unwrap();
+    let normal = NormalEnd::Spectral(Box::new(
+        solve_normal(&sc.model, &disc, sc.normal_load, normal_options).unwrap(),
+    ));
     let mut options = if spectral {
         RunOptions::spectral(Default::default())
     } else {

@@ -8,8 +8,8 @@ use fretsim::contact::normal::{NormalOptions, solve_normal};
 use fretsim::contact::pressure::Discretisation;
 use fretsim::contact::tangential::SlipOptions;
 use fretsim::history::{
-    DriverState, HistoryState, LoadHistory, LoadPoint, NoObserver, RunOptions, StepRecord, advance,
-    continue_run, run_history, solve_step,
+    DriverState, HistoryState, LoadHistory, LoadPoint, NoObserver, NormalEnd, RunOptions,
+    StepRecord, advance, continue_run, run_history, solve_step,
 };
 use fretsim::scenario::{Scenario, default_scenario};
 
@@ -268,8 +268,9 @@ fn cycle(c: &mut Criterion) {
     g.sample_size(10);
     for m in [32, 64] {
         let disc = Discretisation::new(m);
-        let normal =
-            solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap();
+        let normal = NormalEnd::Spectral(Box::new(
+            solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap(),
+        ));
         let history = LoadHistory {
             points: vec![
                 (0.0, 0.0),

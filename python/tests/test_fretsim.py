@@ -97,12 +97,18 @@ def test_out_writes_the_run_folder_and_never_a_users_folder(tmp_path):
 
 
 def test_a_failed_normal_loading_raises_solve_error():
-    """PZT-4 at η = 0.1 with Γ = 2e−7 C/m: no state with one central stick zone exists."""
+    """PZT-4 at η = 0.1 with Γ = 2e−7 C/m: no state with one central stick zone exists, and
+    the spectral solver alone is asked for (the general solver would load it by steps)."""
     scenario = json.loads((SCENARIOS / "baseline.json").read_text())
     scenario["friction"] = 0.1
     scenario["punch"]["electrode"]["charge"] = 2e-7
+    scenario["numerics"] = {"solver": "spectral"}
     with pytest.raises(fretsim.SolveError, match="normal loading"):
         fretsim.run(scenario)
+    del scenario["numerics"]
+    summary = fretsim.run(scenario).summary["normal_loading"]
+    assert summary["solver"] == "general"
+    assert summary["zones"]["stick"] == 3
 
 
 def test_run_many_keeps_the_order_and_returns_the_errors():

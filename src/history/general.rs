@@ -54,13 +54,14 @@ pub const INNER_SIZE: f64 = 6e-3;
 #[serde(rename_all = "snake_case")]
 pub enum SolverChoice {
     /// The spectral solver, and the general solver for the steps it cannot take
-    /// ([`super::continue_run`]).
+    /// ([`super::continue_run`]) and for a normal loading it has no state of
+    /// ([`super::NormalEnd`]).
     #[default]
     Auto,
-    /// The spectral solver only: a step it cannot take stops the run.
+    /// The spectral solver only: a step or a normal loading it cannot take stops the run.
     Spectral,
     /// The general solver for every tangential step (the normal loading stays Spence's
-    /// self-similar solution of the spectral solver).
+    /// self-similar solution of the spectral solver where it has one, as under `Auto`).
     General,
 }
 
@@ -338,6 +339,23 @@ impl GeneralRun {
         }
     }
 
+    /// Start from the end of a normal loading the general solver took (`state`, on
+    /// `solver`'s mesh), before any slip phase, with δ counted from there.
+    pub fn loaded(solver: Arc<Solver>, state: GeneralState) -> Self {
+        Self {
+            solver,
+            offset: -state.shift,
+            state,
+            phase_sign: None,
+            phase: 0,
+            phases_begun: 0,
+            steps: 0,
+            first_began_at_handover: false,
+            works: [[0.0; 2]; 2],
+            resume_at: 2,
+        }
+    }
+
     /// The run written as `data`, its solver rebuilt for `model` on the state's mesh.
     pub fn restore(model: &ContactModel, data: GeneralRunData) -> Self {
         let solver = Solver::new(model, data.state.mesh.clone(), Options::default());
@@ -448,7 +466,7 @@ impl GeneralRun {
     }
 
     /// The record of the committed state, with zero increments.
-    fn record(
+    pub fn record(
         &self,
         step: usize,
         t: f64,

@@ -46,7 +46,9 @@
 //! the spectral solver's step is handed over when the two disagree. The spectral solver tries
 //! to take the state back after 2, 4, 8, … general steps of the phase and at its last step (a try costs about as
 //! much as a spectral step that fails, many general steps). Each record says which solver took
-//! the step ([`SolverKind`]) and the zone structure ([`ZoneCount`]).
+//! the step ([`SolverKind`]) and the zone structure ([`ZoneCount`]). Where the spectral
+//! solver has no normal-loading state, the general solver loads the contact by steps and
+//! holds every step of the history ([`NormalEnd`]; the state then has no spectral driver).
 //!
 //! # Warm start
 //! Inside a phase the geometry of the step (stick ends, contact half-width and centre) is
@@ -87,6 +89,7 @@ internal! { mod general; }
 mod hints;
 mod increments;
 mod load;
+mod normal;
 mod record;
 mod regime;
 mod run;
@@ -94,6 +97,7 @@ mod state;
 
 pub use general::{RunOptions, SolverChoice, SolverKind, ZoneCount};
 pub use load::{LoadHistory, LoadPoint};
+pub use normal::{Loading, NormalEnd};
 pub use record::{NoObserver, Observer, SolvedState, StateView, StepFailure, StepRecord};
 pub use regime::Regime;
 pub use run::{HistoryFailure, HistoryRun, run_history};
@@ -104,6 +108,7 @@ internal_use! { driver::{DriverState, SolvedStep, Trial, Tried, finish_step, try
 pub use driver::{Solved, advance, solve_step};
 internal_use! { general::{GeneralRun, GeneralRunData}; }
 internal_use! { increments::{IncrementInputs, StepIncrements, step_dissipation}; }
+internal_use! { normal::{load_by_steps, locked_in_strain_slope}; }
 internal_use! { record::SolvedStateData; }
 internal_use! { regime::{PhaseEvent, next_regime, phase_event}; }
 internal_use! { run::{continue_run, run_from, turning_points}; }
@@ -121,4 +126,17 @@ pub(crate) fn driver_after_normal_loading(
     use crate::contact::normal::{NormalOptions, solve_normal};
     let normal = solve_normal(&sc.model, disc, sc.normal_load, NormalOptions::default()).unwrap();
     DriverState::after_normal_loading(&normal)
+}
+
+/// The default scenario (PZT-4, conducting punch, R = 60 mm, P = 2000 N/m, its history) with
+/// friction `eta` and charge `gamma` (C/m).
+#[cfg(test)]
+pub(crate) fn default_scenario_with(eta: f64, gamma: f64) -> crate::scenario::Scenario {
+    let mut raw: serde_json::Value =
+        serde_json::from_str(crate::scenario::DEFAULT_SCENARIO).expect("JSON");
+    raw["friction"] = eta.into();
+    raw["punch"]["electrode"]["charge"] = gamma.into();
+    let raw =
+        crate::scenario::parse(&raw.to_string(), std::path::Path::new("<test>")).expect("parses");
+    crate::scenario::validate(raw).expect("valid")
 }

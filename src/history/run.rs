@@ -5,16 +5,16 @@
 
 use crate::contact::ContactModel;
 use crate::contact::general::Recall;
-use crate::contact::normal::NormalLoading;
 use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
 
-use super::driver::{DriverState, SolvedStep, Tried, finish_step, hold_record, record, try_step};
+use super::driver::{DriverState, SolvedStep, Tried, finish_step, hold_record, try_step};
 use super::general::{GeneralRun, RunOptions, SolverChoice, ZoneCount};
 use super::increments::{IncrementInputs, StepIncrements};
 use super::load::{LoadHistory, LoadPoint};
+use super::normal::NormalEnd;
 use super::record::{NoObserver, Observer, StateView, StepFailure, StepRecord};
-use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
+use super::regime::{PhaseEvent, next_regime, phase_event};
 use super::state::{HistoryState, HistoryStateView};
 
 /// A finished run: the records and the final state.
@@ -43,16 +43,15 @@ pub struct HistoryFailure {
 pub fn run_history(
     model: &ContactModel,
     disc: &Discretisation,
-    normal: &NormalLoading,
+    normal: &NormalEnd,
     history: &LoadHistory,
     options: RunOptions,
     observer: &mut dyn Observer,
 ) -> Result<HistoryRun, Box<HistoryFailure>> {
-    let driver = DriverState::after_normal_loading(normal);
     let t0 = history.points.first().map_or(0.0, |p| p.0);
-    let records = vec![record(0, t0, &driver, Regime::NormalLoading, None)];
-    observer.on_step(&records[0], StateView::Spectral(&driver.state));
-    let state = HistoryState::new(driver);
+    let records = vec![normal.record(t0)];
+    observer.on_step(&records[0], normal.view());
+    let state = normal.history_state();
     let points = history.load_points();
     run_from(model, disc, (state, records), &points, options, observer)
 }
@@ -134,8 +133,9 @@ pub fn continue_run(
     let turning = turning_points(current_load(state), points);
     let mut next = 0;
     let mut recall = Recall::new(options.slip.accelerations.general_recall);
-    if options.solver == SolverChoice::General && state.general.is_none() {
-        let driver = &state.driver;
+    if options.solver == SolverChoice::General
+        && let (Some(driver), None) = (&state.driver, &state.general)
+    {
         state.general = Some(GeneralRun::handover(
             model,
             driver,
@@ -145,13 +145,13 @@ pub fn continue_run(
     }
     while next < points.len() {
         let point = points[next];
-        let driver = &mut state.driver;
-        let (mut run, step) = match state.general.take() {
-            Some(mut run) => {
+        let (mut run, step) = match (state.general.take(), &mut state.driver) {
+            (Some(mut run), _) => {
                 let step = run.step(model, point, &mut recall);
                 (run, step)
             }
-            None => {
+            (None, None) => unreachable!("a run state holds a driver or a general run"),
+            (None, Some(driver)) => {
                 let stop = spectral_stretch(
                     model,
                     disc,
@@ -191,22 +191,23 @@ pub fn continue_run(
             }
         };
         let mut record = record;
-        let back = match options.solver {
-            SolverChoice::Auto => resumes(
+        let back = match (options.solver, &mut state.driver) {
+            (SolverChoice::Auto, Some(driver)) => resumes(
                 model,
                 disc,
                 driver,
                 &mut run,
                 (points[next], &record, turning[next]),
                 options.slip,
-            ),
+            )
+            .map(|increments| (increments, driver.displacement)),
             _ => None,
         };
-        if let Some(increments) = &back {
+        if let Some((increments, displacement)) = &back {
             // The general steps since the handover add up to the spectral solver's increments
             // over them: this step takes the rest (see `resumes`).
             let [normal, electric] = run.works_before_this_step();
-            record.displacement = driver.displacement;
+            record.displacement = *displacement;
             record.normal_work = increments.normal_work - normal;
             record.electric_work = increments.electric_work - electric;
         }
@@ -236,7 +237,14 @@ fn keep(records: &mut Vec<StepRecord>, record: StepRecord, all: bool) {
 fn current_load(state: &HistoryState) -> f64 {
     match &state.general {
         Some(run) => run.state.loads.tangential,
-        None => state.driver.state.tangential_load,
+        None => {
+            state
+                .driver
+                .as_ref()
+                .expect("a run state holds a driver or a general run")
+                .state
+                .tangential_load
+        }
     }
 }
 
@@ -391,7 +399,7 @@ fn spectral_stretch(
             if turning[k] {
                 finish(pending.take(), driver, records, observer);
                 let view = HistoryStateView {
-                    driver,
+                    driver: Some(driver),
                     general: None,
                 };
                 observer.on_checkpoint(records.last().expect("just pushed"), view);

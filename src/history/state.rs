@@ -20,8 +20,11 @@ use super::general::{GeneralRun, GeneralRunData};
 #[derive(Debug, Clone)]
 pub struct HistoryState {
     /// The spectral solver's committed state, memory, phase and displacement datum (while the
-    /// general solver holds the steps: those of the step it took over at).
-    pub driver: DriverState,
+    /// general solver holds the steps: those of the step it took over at); `None` when the
+    /// general solver took the normal loading, whose past the spectral memory cannot describe
+    /// (then the general solver holds every step, [`super::NormalEnd`]). One of the two is
+    /// always there.
+    pub driver: Option<DriverState>,
     /// The general solver's run while it holds the steps.
     pub general: Option<GeneralRun>,
 }
@@ -29,7 +32,7 @@ pub struct HistoryState {
 /// A [`HistoryState`] as read back, before its general solver is rebuilt.
 #[derive(Debug, Clone)]
 pub struct HistoryStateData {
-    driver: DriverState,
+    driver: Option<DriverState>,
     general: Option<GeneralRunData>,
 }
 
@@ -38,20 +41,20 @@ pub struct HistoryStateData {
 #[derive(Debug, Clone, Copy)]
 pub struct HistoryStateView<'a> {
     /// See [`HistoryState::driver`].
-    pub driver: &'a DriverState,
+    pub driver: Option<&'a DriverState>,
     /// See [`HistoryState::general`].
     pub general: Option<&'a GeneralRun>,
 }
 
 #[derive(Serialize)]
 struct Written<'a> {
-    driver: &'a DriverState,
+    driver: Option<&'a DriverState>,
     general: Option<&'a GeneralRun>,
 }
 
 #[derive(Deserialize)]
 struct Read {
-    driver: DriverState,
+    driver: Option<DriverState>,
     general: Option<GeneralRunData>,
 }
 
@@ -83,7 +86,7 @@ impl HistoryState {
     /// The state at the start of a run from a driver.
     pub fn new(driver: DriverState) -> Self {
         Self {
-            driver,
+            driver: Some(driver),
             general: None,
         }
     }
@@ -91,7 +94,7 @@ impl HistoryState {
     /// The borrowed view.
     pub fn view(&self) -> HistoryStateView<'_> {
         HistoryStateView {
-            driver: &self.driver,
+            driver: self.driver.as_ref(),
             general: self.general.as_ref(),
         }
     }
@@ -140,6 +143,18 @@ mod tests {
     fn continue_from_every_checkpoint(solver: SolverChoice, segments: usize) {
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(sc.collocation_points);
+        let start = HistoryState::new(driver_after_normal_loading(&sc, &disc));
+        continue_from_every_checkpoint_of(&sc, start, solver, segments);
+    }
+
+    /// [`continue_from_every_checkpoint`] for scenario `sc` (its history) from `start`.
+    fn continue_from_every_checkpoint_of(
+        sc: &crate::scenario::Scenario,
+        start: HistoryState,
+        solver: SolverChoice,
+        segments: usize,
+    ) {
+        let disc = Discretisation::new(sc.collocation_points);
         let history = sc.history.as_ref().expect("a history");
         let points: Vec<LoadPoint> = history
             .load_points()
@@ -147,7 +162,7 @@ mod tests {
             .take(segments * history.steps_per_segment)
             .collect();
         let options = RunOptions::new(solver);
-        let mut state = HistoryState::new(driver_after_normal_loading(&sc, &disc));
+        let mut state = start;
         let mut checkpoints = Checkpoints::default();
         let mut records = Vec::new();
         let failure = continue_run(
@@ -198,5 +213,23 @@ mod tests {
     #[test]
     fn a_general_solver_run_continued_from_a_checkpoint_takes_the_same_steps_to_the_bit() {
         continue_from_every_checkpoint(SolverChoice::General, 3);
+    }
+
+    /// A run whose normal loading the general solver took (no spectral driver in the state).
+    #[test]
+    fn a_run_loaded_by_the_general_solver_continued_from_a_checkpoint_takes_the_same_steps() {
+        let sc = crate::history::default_scenario_with(0.1, 2e-7);
+        let disc = Discretisation::new(sc.collocation_points);
+        let start = crate::history::NormalEnd::solve(
+            &sc.model,
+            &disc,
+            sc.normal_load,
+            SolverChoice::Auto,
+            crate::history::general::INNER_SIZE,
+        )
+        .unwrap()
+        .history_state();
+        assert!(start.driver.is_none());
+        continue_from_every_checkpoint_of(&sc, start, SolverChoice::Auto, 3);
     }
 }

@@ -57,17 +57,49 @@ pub enum ComplianceSource {
 /// `None` without two steps of one phase after its start.
 #[cfg(test)]
 fn stuck_compliance(records: &[StepRecord]) -> Option<(f64, ComplianceSource)> {
-    let mut tally = ComplianceTally::default();
+    let mut tally = Compliances::default();
     records.iter().for_each(|r| tally.push(r));
     tally.compliance()
 }
 
+/// The stuck compliance from the spectral solver's phase starts ([`ComplianceTally`]), or,
+/// in a history with none (the general solver took every step, its normal loading included),
+/// from the general solver's: its δ then carries the same discretisation error as the loop
+/// it is drawn with.
+#[derive(Debug, Clone)]
+struct Compliances([ComplianceTally; 2]);
+
+impl Default for Compliances {
+    fn default() -> Self {
+        Self([SolverKind::Spectral, SolverKind::General].map(|kind| ComplianceTally {
+            kind,
+            ..ComplianceTally::default()
+        }))
+    }
+}
+
+impl Compliances {
+    fn push(&mut self, r: &StepRecord) {
+        self.0.iter_mut().for_each(|t| t.push(r));
+    }
+
+    fn compliance(&self) -> Option<(f64, ComplianceSource)> {
+        let [spectral, general] = &self.0;
+        if spectral.first.is_some() {
+            spectral.compliance()
+        } else {
+            general.compliance()
+        }
+    }
+}
+
 /// [`stuck_compliance`] as the records arrive: each phase start (the step before the phase,
-/// with the phase's first two steps of the spectral solver; a general step's δ carries its
-/// element discretisation error, which the slope would amplify), folded into the least slope
-/// at a reversal and the slope at the first start.
+/// with the phase's first two steps of one solver, `kind`: a general step's δ carries its
+/// element discretisation error, which the slope would amplify in a mix), folded into the
+/// least slope at a reversal and the slope at the first start.
 #[derive(Debug, Clone, Default)]
 struct ComplianceTally {
+    kind: SolverKind,
     previous: Option<StepRecord>,
     /// The phase start under way: the step before it and its spectral steps so far.
     start: Option<(StepRecord, Vec<StepRecord>)>,
@@ -84,7 +116,7 @@ impl ComplianceTally {
         {
             self.start = Some((prev, Vec::new()));
         }
-        if r.solver == SolverKind::Spectral
+        if r.solver == self.kind
             && let Some((before, own)) = &mut self.start
         {
             own.push(r.clone());
@@ -215,7 +247,7 @@ pub(crate) struct PlotWindow {
     /// Steps taken, and steps dropped between the head and the tail.
     taken: usize,
     dropped: usize,
-    compliance: ComplianceTally,
+    compliance: Compliances,
     recall: RecallTally,
 }
 
@@ -233,7 +265,7 @@ impl PlotWindow {
             tail: Default::default(),
             taken: 0,
             dropped: 0,
-            compliance: ComplianceTally::default(),
+            compliance: Compliances::default(),
             recall: RecallTally::new(q_scale),
         }
     }

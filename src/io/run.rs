@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use crate::analysis::{CycleAnalysis, CycleRow};
 use crate::contact::SurfacePoint;
-use crate::contact::normal::{NormalLoading, NormalOptions, solve_normal};
+use crate::contact::normal::NormalLoading;
+use crate::history::NormalEnd;
 use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
 use crate::error::Error;
@@ -337,12 +338,22 @@ pub(crate) fn solve_from<'a>(
 ) -> Result<Solution, Error> {
     let model = &scenario.model;
     let disc = Discretisation::new(scenario.collocation_points);
-    let normal = solve_normal(model, &disc, scenario.normal_load, NormalOptions::default())
-        .map_err(|failure| Error::Solve {
-            context: "normal loading".into(),
-            failure,
-        })?;
-    let mut warnings: Vec<String> = gap_warning(scenario, &normal).into_iter().collect();
+    let normal = NormalEnd::solve(
+        model,
+        &disc,
+        scenario.normal_load,
+        scenario.solver,
+        scenario.raw.numerics.general_element_size,
+    )
+    .map_err(|failure| Error::Solve {
+        context: "normal loading".into(),
+        failure,
+    })?;
+    let mut warnings: Vec<String> = normal
+        .spectral()
+        .and_then(|n| gap_warning(scenario, n))
+        .into_iter()
+        .collect();
     // The tangential history, if any; a failure keeps the steps already solved. A written run
     // (with a sink) streams its records into the digest and `steps.csv` and keeps none.
     let written = checkpoints.is_some();
@@ -466,8 +477,8 @@ pub(crate) fn solve_from<'a>(
     let mut fields = vec![FieldSet {
         stem: "normal_loading".into(),
         label: "end of normal loading".into(),
-        points: sample(&SolvedState::Spectral(Box::new(normal.state.clone()))),
-        ends: ZoneEnds::of(&normal.state),
+        points: sample(&normal.solved_state()),
+        ends: zone_ends(&normal.solved_state(), &normal.record(0.0)),
     }];
     let (at_snapshots, snapshot_rows) =
         snapshot_fields(scenario, &kept.at_times, &sample, tally.last(), &mut warnings);

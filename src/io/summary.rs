@@ -9,6 +9,7 @@ use crate::analysis::{CycleRow, Verdict};
 use crate::contact::ContactModel;
 use crate::contact::normal::NormalLoading;
 use crate::halfplane::{PaperCoefficients, SurfaceCompliance, SurfaceFieldCoefficients};
+use crate::history::{Loading, NormalEnd, ZoneCount};
 use crate::history::{SolverKind, StepRecord};
 use crate::scenario::{RawScenario, Scenario};
 
@@ -61,8 +62,18 @@ pub struct NormalSummary {
     /// Charge carried by the pressure, Γ1 = kP (C/m).
     pub pressure_charge: f64,
     /// q/(ηp) in the right slip zone: +1 when the friction points outward, −1 inward (which
-    /// happens below Γ1 for a conducting punch); 0 without slip zones.
+    /// happens below Γ1 for a conducting punch); 0 without slip zones. Of a general solver's
+    /// state: in the slip zone right of its longest stick zone.
     pub right_slip_sign: f64,
+    /// The solver that gave the state: `spectral` (Spence's self-similar state) or `general`
+    /// (loaded by steps where the spectral form holds no state; `history::NormalEnd`).
+    pub solver: SolverKind,
+    /// The zone structure of the state.
+    pub zones: ZoneCount,
+    /// Load steps of the general solver's loading (0 for the spectral solver's state).
+    pub load_steps: usize,
+    /// Why the spectral solver gave no state, when the general solver did.
+    pub spectral_failure: Option<String>,
 }
 
 /// `summary.json`.
@@ -102,7 +113,14 @@ pub fn derived(model: &ContactModel, normal_load: f64) -> Derived {
     }
 }
 
-pub(crate) fn normal_summary(model: &ContactModel, n: &NormalLoading) -> NormalSummary {
+pub(crate) fn normal_summary(model: &ContactModel, normal: &NormalEnd) -> NormalSummary {
+    match normal {
+        NormalEnd::Spectral(n) => spectral_normal_summary(model, n),
+        NormalEnd::General(run, loading) => general_normal_summary(model, run, loading),
+    }
+}
+
+pub(crate) fn spectral_normal_summary(model: &ContactModel, n: &NormalLoading) -> NormalSummary {
     let s = &n.state;
     let w_total = s.potential_charge_force();
     NormalSummary {
@@ -122,7 +140,84 @@ pub(crate) fn normal_summary(model: &ContactModel, n: &NormalLoading) -> NormalS
         outside_gap: model.outside_gap(s),
         pressure_charge: model.pressure_charge(s.normal_load),
         right_slip_sign: s.traction.right_sign,
+        solver: SolverKind::Spectral,
+        zones: ZoneCount::of_spectral(s),
+        load_steps: 0,
+        spectral_failure: None,
     }
+}
+
+/// The summary of a general solver's normal loading: the contact ends are the outer edges of
+/// its contact elements, the stick zone its longest run of stuck elements, the checks those of
+/// its steps (`history::general`), and the gap the element mean gap outside the contact.
+fn general_normal_summary(
+    model: &ContactModel,
+    run: &crate::history::GeneralRun,
+    loading: &Loading,
+) -> NormalSummary {
+    let s = &run.state;
+    let rec = run.record(0, 0.0, crate::history::Regime::NormalLoading, None);
+    let (pressure_resultant, _, charge_resultant) = s.resultants();
+    let a = rec.half_width;
+    let stick_half_width = 0.5 * (rec.stick_hi - rec.stick_lo);
+    let check = rec.admissibility;
+    let conducting = matches!(
+        model.electrode,
+        crate::contact::Electrode::ConductingCharge { .. }
+            | crate::contact::Electrode::ConductingPotential { .. }
+    );
+    NormalSummary {
+        half_width: a,
+        eccentricity: rec.eccentricity,
+        stick_half_width,
+        stick_ratio: stick_half_width / a,
+        strain_slope: crate::history::locked_in_strain_slope(s),
+        peak_pressure: s.pressure.iter().copied().fold(0.0, f64::max),
+        charge: charge_resultant,
+        potential: conducting.then_some(s.potential),
+        pressure_resultant,
+        charge_resultant,
+        iterations: loading.iterations,
+        admissibility: crate::contact::normal::Admissibility {
+            stick_excess: check.stick_excess,
+            stick_excess_at: check.worst_at[0],
+            slip_reversal: check.slip_reversal,
+            slip_reversal_at: check.worst_at[1],
+            min_pressure: check.min_pressure,
+        },
+        outside_gap: outside_gap(model, run, (-rec.eccentricity, a)),
+        pressure_charge: model.pressure_charge(s.loads.normal),
+        right_slip_sign: rec.right_slip_sign,
+        solver: SolverKind::General,
+        zones: ZoneCount::of_elements(s),
+        load_steps: loading.steps,
+        spectral_failure: Some(loading.spectral_failure.clone()),
+    }
+}
+
+/// The smallest element mean gap within one half-width outside either end of an element
+/// state's contact `(c, a)`.
+fn outside_gap(
+    model: &ContactModel,
+    run: &crate::history::GeneralRun,
+    (c, a): (f64, f64),
+) -> crate::contact::GapReport {
+    let s = &run.state;
+    let gaps = run.solver().gaps(s);
+    let mut report = crate::contact::GapReport {
+        min_gap: f64::INFINITY,
+        at: c + a,
+        scale: model.profile.gap(a),
+    };
+    for (i, &gap) in gaps.iter().enumerate() {
+        let x = s.mesh.centre(i);
+        let outside = ((x - c).abs() - a) / a;
+        if outside > 0.0 && outside <= 1.0 && gap < report.min_gap {
+            report.min_gap = gap;
+            report.at = x;
+        }
+    }
+    report
 }
 
 /// Summary of the tangential history, in `summary.json`.
@@ -176,7 +271,8 @@ pub struct SolverStatistics {
     pub residual_evaluations: usize,
     /// Largest final residual of a step of the spectral solver.
     pub max_residual: Option<f64>,
-    /// Steps taken by the general element solver (`solver` in `steps.csv`).
+    /// History steps taken by the general element solver (`solver` in `steps.csv`; the end of
+    /// normal loading, step 0, is not counted: see `normal_loading.solver`).
     pub general_steps: usize,
     /// The steps at which the general solver took over, with the reason the spectral solver
     /// could not take each: the first and the last [`LISTED`].
@@ -399,7 +495,7 @@ impl RecordTally {
             worst(&mut self.worst_stick_excess, r.admissibility.stick_excess);
             worst(&mut self.worst_slip_reversal, r.admissibility.slip_reversal);
         }
-        if r.solver == SolverKind::General {
+        if r.solver == SolverKind::General && r.step > 0 {
             self.general_steps += 1;
         }
         if r.solver == SolverKind::Spectral && r.residual >= self.stall {
@@ -430,13 +526,16 @@ impl RecordTally {
 
 pub(crate) fn solver_statistics(
     scenario: &Scenario,
-    normal: &NormalLoading,
+    normal: &NormalEnd,
     tally: &RecordTally,
     handovers: HandoverLog,
 ) -> SolverStatistics {
     SolverStatistics {
         collocation_points: scenario.collocation_points,
-        normal_loading_iterations: normal.iterations,
+        normal_loading_iterations: match normal {
+            NormalEnd::Spectral(n) => n.iterations,
+            NormalEnd::General(_, loading) => loading.iterations,
+        },
         history_steps: tally.records.saturating_sub(1),
         newton_iterations: tally.newton_iterations,
         max_newton_iterations: tally.max_newton_iterations,

@@ -4,7 +4,6 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::contact::normal::{NormalOptions, solve_normal};
 use crate::contact::pressure::Discretisation;
 use crate::error::Error;
 use crate::io::folder::{Protected, RunFolder, SweepFolder};
@@ -487,7 +486,13 @@ pub fn sweep(
                 }
             } else {
                 let disc = Discretisation::new(sc.collocation_points);
-                match solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()) {
+                match crate::history::NormalEnd::solve(
+                    &sc.model,
+                    &disc,
+                    sc.normal_load,
+                    sc.solver,
+                    sc.raw.numerics.general_element_size,
+                ) {
                     Ok(n) => VariantOutcome {
                         normal: Some(normal_summary(&sc.model, &n)),
                         error: None,

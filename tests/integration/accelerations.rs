@@ -17,7 +17,9 @@ fn default_run(accelerations: Accelerations, zone_tables: ZoneTables) -> Vec<Ste
         zone_tables,
         ..NormalOptions::default()
     };
-    let normal = solve_normal(&sc.model, &disc, sc.normal_load, normal_options).unwrap();
+    let normal = fretsim::history::NormalEnd::Spectral(Box::new(
+        solve_normal(&sc.model, &disc, sc.normal_load, normal_options).unwrap(),
+    ));
     let mut options = RunOptions::new(sc.solver);
     options.slip.accelerations = accelerations;
     let history = sc

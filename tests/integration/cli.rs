@@ -36,6 +36,10 @@ struct Normal {
     outside_gap: serde_json::Value,
     pressure_charge: f64,
     right_slip_sign: f64,
+    solver: String,
+    zones: serde_json::Value,
+    load_steps: usize,
+    spectral_failure: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -399,7 +403,7 @@ fn run_scenario(name: &str) -> (tempfile::TempDir, PathBuf, Summary) {
 }
 
 /// The scenarios with a test of their own below; a file in `scenarios/` without one fails.
-const SCENARIOS: [&str; 11] = [
+const SCENARIOS: [&str; 12] = [
     "baseline",
     "cattaneo_mindlin_uncoupled",
     "figure3_history",
@@ -410,6 +414,7 @@ const SCENARIOS: [&str; 11] = [
     "insulating",
     "many_cycles",
     "partial_unload_reload",
+    "small_friction_below_gamma1",
     "variable_amplitude",
 ];
 
@@ -456,6 +461,38 @@ fn scenario_baseline() {
     // Paper baseline (Figures 6–9 at η = 0.3): a large stick zone.
     assert!(s.normal_loading.stick_ratio > 0.9 && s.normal_loading.stick_ratio < 1.0);
     assert!(s.warnings.iter().any(|w| w.contains("Γ1")));
+}
+
+/// No normal-loading state with one central stick zone: the general solver loads the contact
+/// by steps and takes every step of the history (`history::NormalEnd`).
+#[test]
+fn scenario_small_friction_below_gamma1() {
+    let (_tmp, out, s) = run_scenario("small_friction_below_gamma1");
+    let n = &s.normal_loading;
+    assert_eq!(n.solver, "general");
+    assert!(n.load_steps > 100);
+    assert!(
+        n.spectral_failure
+            .as_deref()
+            .is_some_and(|f| f.contains("no stick/slip state of the assumed form"))
+    );
+    assert_eq!(n.zones["stick"], 3);
+    assert!((n.pressure_resultant / 2000.0 - 1.0).abs() < 1e-12);
+    assert!(n.stick_ratio > 0.1 && n.stick_ratio < 0.2);
+    let h = s.history.as_ref().unwrap();
+    assert_eq!(h.steps, 90);
+    assert_eq!(s.solver.general_steps, 90);
+    assert_eq!(s.solver.handover_count, 0);
+    let (header, rows) = read_csv(&out.join("steps.csv"));
+    let solver = header.split(',').position(|c| c == "solver").unwrap();
+    assert_eq!(rows.len(), 91);
+    let text = std::fs::read_to_string(out.join("steps.csv")).unwrap();
+    assert!(
+        text.lines()
+            .skip(1)
+            .all(|l| l.split(',').nth(solver) == Some("general"))
+    );
+    assert!(out.join("fields/normal_loading.csv").exists());
 }
 
 #[test]
@@ -1200,7 +1237,8 @@ fn solver_failure_exits_1_and_keeps_the_steps_solved() {
     let model = fretsim::load(&file).unwrap().model;
     let state = fretsim::history::HistoryState::restore(&model, f.state);
     let q = f.last_accepted_step["q"].as_f64().unwrap();
-    assert_eq!(state.driver.state.tangential_load.to_bits(), q.to_bits());
+    let driver = state.driver.expect("the spectral solver held the steps");
+    assert_eq!(driver.state.tangential_load.to_bits(), q.to_bits());
     let s = read_summary(&out);
     let h = s.history.as_ref().unwrap();
     assert_eq!(h.failure.as_deref(), Some(f.error.as_str()));

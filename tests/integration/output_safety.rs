@@ -281,7 +281,8 @@ fn an_unwritable_output_folder_is_reported_before_the_solve() {
 
 /// When the normal loading fails the run exits 1 and still writes `failure.json`: PZT-4 at
 /// η = 0.1 with Γ = 2e−7 C/m, below the charge the pressure carries (Γ1 = 5.0e−7 C/m), where
-/// no state with one central stick zone exists.
+/// no state with one central stick zone exists, and the spectral solver alone is asked for
+/// (`auto` has the general solver load it by steps).
 #[test]
 fn a_failed_normal_loading_exits_1_with_failure_json() {
     let tmp = tempfile::tempdir().unwrap();
@@ -289,6 +290,7 @@ fn a_failed_normal_loading_exits_1_with_failure_json() {
     let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
     v["friction"] = serde_json::json!(0.1);
     v["punch"]["electrode"]["charge"] = serde_json::json!(2e-7);
+    v["numerics"] = serde_json::json!({ "solver": "spectral" });
     let file = tmp.path().join("s.json");
     std::fs::write(&file, v.to_string()).unwrap();
     let out = tmp.path().join("out");

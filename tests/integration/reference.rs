@@ -89,7 +89,7 @@ fn run_points(
     run_history(
         model,
         disc,
-        normal,
+        &fretsim::history::NormalEnd::Spectral(Box::new(normal.clone())),
         &history,
         fretsim::history::RunOptions::spectral(SlipOptions::default()),
         &mut NoObserver,
@@ -130,7 +130,7 @@ fn records_of(
     run_history(
         &b.model,
         &b.disc,
-        &b.normal,
+        &fretsim::history::NormalEnd::Spectral(Box::new(b.normal.clone())),
         &history,
         fretsim::history::RunOptions::spectral(options),
         &mut NoObserver,
@@ -257,6 +257,7 @@ fn ramped_state(
     )
     .state
     .driver
+    .expect("a spectral run")
     .state
 }
 
@@ -645,7 +646,7 @@ fn reference_cattaneo_mindlin_deresiewicz_masing() {
         let records = run_history(
             &model,
             &disc,
-            &normal,
+            &fretsim::history::NormalEnd::Spectral(Box::new(normal)),
             &history,
             fretsim::history::RunOptions::spectral(opts),
             &mut recorder,
@@ -899,6 +900,7 @@ fn inherited_chains_stop_growing_in_steady_cycles() {
         run_points(&b.model, &b.disc, &b.normal, points, 1, 0.1 * b.lim)
             .state
             .driver
+            .expect("a spectral run")
             .state
     };
     let (three, six) = (end_of(3), end_of(6));
@@ -1275,7 +1277,7 @@ fn figure3_history_completes_without_the_stick_end_kinks() {
         .collect();
     let run = run_points(&b.model, &b.disc, &b.normal, points, 10, 0.05 * lim);
     assert_eq!(run.records.len(), 61);
-    let s = &run.state.driver.state;
+    let s = &run.state.driver.as_ref().expect("a spectral run").state;
     assert!(s.pressure_kinks.0.is_empty() && s.charge_kinks.0.is_empty());
     let zone = s.traction.stick.as_ref().unwrap();
     assert!(zone.extras.is_empty() && zone.end_roots == [0.0; 2]);
@@ -1481,7 +1483,7 @@ fn pipelined_history_matches_sequential_steps() {
     let run = run_history(
         &b.model,
         &b.disc,
-        &b.normal,
+        &fretsim::history::NormalEnd::Spectral(Box::new(b.normal.clone())),
         &history,
         fretsim::history::RunOptions::spectral(options),
         &mut NoObserver,
@@ -1502,7 +1504,12 @@ fn pipelined_history_matches_sequential_steps() {
     assert!(sequential.iter().any(|r| r.dissipation > 0.0));
     assert_eq!(&run.records[1..], &sequential[..]);
     assert_eq!(
-        run.state.driver.displacement.to_bits(),
+        run.state
+            .driver
+            .as_ref()
+            .expect("a spectral run")
+            .displacement
+            .to_bits(),
         driver.displacement.to_bits()
     );
     // Two steps sequentially, then the rest (the hold, the reversal) as a run continues.
@@ -1524,7 +1531,11 @@ fn pipelined_history_matches_sequential_steps() {
     assert!(failure.is_none());
     assert_eq!(&records[..], &sequential[2..]);
     assert_eq!(
-        part.driver.displacement.to_bits(),
+        part.driver
+            .as_ref()
+            .expect("a spectral run")
+            .displacement
+            .to_bits(),
         driver.displacement.to_bits()
     );
 }
@@ -1912,7 +1923,7 @@ fn batched_fields_equal_the_one_point_fields() {
     run_history(
         &b.model,
         &b.disc,
-        &b.normal,
+        &fretsim::history::NormalEnd::Spectral(Box::new(b.normal.clone())),
         &history,
         fretsim::history::RunOptions::spectral(SlipOptions::default()),
         &mut states,
@@ -2053,7 +2064,7 @@ fn remembered_end_next_to_a_new_stick_end_stays_converged() {
             run_history(
                 &sc.model,
                 &disc,
-                &normal,
+                &fretsim::history::NormalEnd::Spectral(Box::new(normal.clone())),
                 history,
                 fretsim::history::RunOptions::spectral(options),
                 &mut NoObserver,
@@ -2118,7 +2129,7 @@ fn a_recalled_step_from_another_start_computes_its_own_increments() {
         fretsim::history::run_history(
             &b.model,
             &b.disc,
-            &b.normal,
+            &fretsim::history::NormalEnd::Spectral(Box::new(b.normal.clone())),
             &history,
             fretsim::history::RunOptions::spectral(
                 fretsim::contact::tangential::SlipOptions::default(),

@@ -398,17 +398,40 @@ impl Solver {
         c.coupled && c.friction > 0.0 && (c.w12 != 0.0 || w13 != 0.0)
     }
 
+    /// Hertz's half-width `√(2P Y*/(π κ))` for the loads, with the pressure compliance
+    /// `Y* = y22` (no charge on the contact) or `y22 − y23²/y33` (a conducting punch) and the
+    /// profile's curvature κ: a first guess of the contact (m).
+    pub fn hertz_half_width(&self, loads: Loads) -> f64 {
+        let c = &self.coefficients;
+        let ystar = match (self.electric_control(loads), c.electric) {
+            (ElectricControl::None, _) | (_, None) => c.y22,
+            (_, Some((y23, y33, _))) => c.y22 - y23 * y23 / y33,
+        };
+        (2.0 * loads.normal * ystar / (c.profile.curvature() * PI)).sqrt()
+    }
+
+    /// The mean gap between the punch and the surface over each element of a state,
+    /// `(1/Δi)∫(uz − δz + x²/2R) dx` (m): zero on the contact, and ≥ 0 outside it where the
+    /// state is admissible.
+    pub fn gaps(&self, state: &GeneralState) -> Vec<f64> {
+        let input = NormalInput {
+            mesh: &self.mesh,
+            influence: &self.influence,
+            coefficients: &self.coefficients,
+            shear: &state.shear,
+            normal_load: state.loads.normal,
+            electric: self.electric_control(state.loads),
+            grow: false,
+        };
+        normal::gaps(&input, &state.pressure, &state.charge, state.approach)
+    }
+
     /// The contact elements of the start of a step: the previous contact, or Hertz's width
     /// with the pressure compliance of the electrode if there was none.
     fn initial_contact(&self, previous: &GeneralState, loads: Loads) -> Vec<bool> {
         let mut contact: Vec<bool> = previous.pressure.iter().map(|&p| p > 0.0).collect();
         if !contact.iter().any(|&c| c) {
-            let c = &self.coefficients;
-            let ystar = match (self.electric_control(loads), c.electric) {
-                (ElectricControl::None, _) | (_, None) => c.y22,
-                (_, Some((y23, y33, _))) => c.y22 - y23 * y23 / y33,
-            };
-            let a = (2.0 * loads.normal * ystar / (c.profile.curvature() * PI)).sqrt();
+            let a = self.hertz_half_width(loads);
             for (i, flag) in contact.iter_mut().enumerate() {
                 let (x1, x2) = (self.mesh.edges[i], self.mesh.edges[i + 1]);
                 *flag = x2.abs().min(x1.abs()) < a || (x1 <= 0.0 && x2 >= 0.0);

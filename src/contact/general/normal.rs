@@ -73,7 +73,7 @@ pub(super) fn solve(
             }
             continue;
         }
-        let gaps = gaps(input, &sol);
+        let gaps = gaps(input, &sol.pressure, &sol.charge, sol.approach);
         // Gap tolerance: 1e−9 of the profile height at the outermost contact element.
         let scale = (0..n)
             .filter(|&i| contact[i])
@@ -151,14 +151,14 @@ fn extend(
 }
 
 /// Mean gap per element, `(1/Δi)∫(uz − δz + x²/2R)`, for every element.
-fn gaps(input: &NormalInput, sol: &NormalSolution) -> Vec<f64> {
+pub(super) fn gaps(input: &NormalInput, pressure: &[f64], charge: &[f64], approach: f64) -> Vec<f64> {
     let c = input.coefficients;
     let n = input.mesh.len();
     let mut lp = vec![0.0; n];
-    input.influence.log_apply(&sol.pressure, &mut lp);
+    input.influence.log_apply(pressure, &mut lp);
     let mut lg = vec![0.0; n];
     if c.electric.is_some() {
-        input.influence.log_apply(&sol.charge, &mut lg);
+        input.influence.log_apply(charge, &mut lg);
     }
     let mut sq = vec![0.0; n];
     if c.coupled {
@@ -170,7 +170,7 @@ fn gaps(input: &NormalInput, sol: &NormalSolution) -> Vec<f64> {
             let (x1, x2) = (input.mesh.edges[i], input.mesh.edges[i + 1]);
             let w = x2 - x1;
             let uz = -(c.y22 / PI) * lp[i] - (y23 / PI) * lg[i] + 0.5 * c.w12 * sq[i];
-            (uz - w * sol.approach + c.profile.gap_integral(x1, x2)) / w
+            (uz - w * approach + c.profile.gap_integral(x1, x2)) / w
         })
         .collect()
 }
