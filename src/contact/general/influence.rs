@@ -52,6 +52,41 @@ impl Influence {
         mat_vec(&self.log, v, out);
     }
 
+    /// `out_i = (log · v)_i` for the elements `i` with `rows[i]`, and 0 for the others, with
+    /// `v` zero outside `support` (a range of elements): by the symmetry of `log`, each run of
+    /// such rows is a block of columns, transposed, times `v` on its support.
+    pub fn log_apply_rows(
+        &self,
+        v: &[f64],
+        support: std::ops::Range<usize>,
+        rows: &[bool],
+        out: &mut [f64],
+    ) {
+        out.fill(0.0);
+        let vs = ColRef::from_slice(&v[support.clone()]).as_mat();
+        let mut start = 0;
+        while start < rows.len() {
+            if !rows[start] {
+                start += 1;
+                continue;
+            }
+            let end = (start..rows.len()).find(|&i| !rows[i]).unwrap_or(rows.len());
+            let block = self
+                .log
+                .as_ref()
+                .submatrix(support.start, start, support.len(), end - start);
+            faer::linalg::matmul::matmul(
+                ColMut::from_slice_mut(&mut out[start..end]).as_mat_mut(),
+                Accum::Replace,
+                block.transpose(),
+                vs,
+                1.0,
+                Par::Seq,
+            );
+            start = end;
+        }
+    }
+
     /// `out = sign · v`: `out_i = w_i (Σ_{j<i} w_j v_j − Σ_{j>i} w_j v_j)`.
     pub fn sign_apply(&self, v: &[f64], out: &mut [f64]) {
         let total: f64 = v.iter().zip(&self.widths).map(|(v, w)| v * w).sum();
@@ -108,6 +143,23 @@ fn sign_pair(i: usize, j: usize, wi: f64, wj: f64) -> f64 {
                 "{i}: {} vs {direct}",
                 out[i]
             );
+        }
+    }
+
+    /// The product on chosen rows with `v` zero outside its support: the full product's
+    /// rows, to round-off, and 0 on the other rows.
+    #[test]
+    fn log_apply_rows_matches_the_full_product_on_its_rows() {
+        let mesh = Mesh::uniform(-1.0, 1.0, 9);
+        let inf = Influence::new(&mesh, 3.0);
+        let v = [0.0, 0.0, 0.3, -1.2, 2.0, 0.7, -0.4, 0.0, 0.0];
+        let rows = [true, true, false, false, true, false, false, true, true];
+        let (mut full, mut some) = ([0.0; 9], [1.0; 9]);
+        inf.log_apply(&v, &mut full);
+        inf.log_apply_rows(&v, 2..7, &rows, &mut some);
+        for i in 0..9 {
+            let expected = if rows[i] { full[i] } else { 0.0 };
+            assert!((some[i] - expected).abs() < 1e-14, "{i}: {} vs {expected}", some[i]);
         }
     }
 

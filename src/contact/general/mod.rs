@@ -411,8 +411,8 @@ impl Solver {
     }
 
     /// The mean gap between the punch and the surface over each element of a state,
-    /// `(1/Δi)∫(uz − δz + x²/2R) dx` (m): zero on the contact, and ≥ 0 outside it where the
-    /// state is admissible.
+    /// `(1/Δi)∫(uz − δz + x²/2R) dx` (m): ≥ 0 outside the contact where the state is
+    /// admissible, and 0 on the contact elements (where the contact equations make it zero).
     pub fn gaps(&self, state: &GeneralState) -> Vec<f64> {
         let input = NormalInput {
             mesh: &self.mesh,
@@ -423,7 +423,16 @@ impl Solver {
             electric: self.electric_control(state.loads),
             grow: false,
         };
-        normal::gaps(&input, &state.pressure, &state.charge, state.approach)
+        let contact: Vec<bool> = state
+            .codes
+            .iter()
+            .map(|&c| c != ElementState::Exterior)
+            .collect();
+        normal::gaps(
+            &input,
+            (&state.pressure, &state.charge, state.approach),
+            &contact,
+        )
     }
 
     /// The contact elements of the start of a step: the previous contact, or Hertz's width

@@ -73,7 +73,11 @@ pub(super) fn solve(
             }
             continue;
         }
-        let gaps = gaps(input, &sol.pressure, &sol.charge, sol.approach);
+        let gaps = gaps(
+            input,
+            (&sol.pressure, &sol.charge, sol.approach),
+            &sol.contact,
+        );
         // Gap tolerance: 1e−9 of the profile height at the outermost contact element.
         let scale = (0..n)
             .filter(|&i| contact[i])
@@ -150,15 +154,29 @@ fn extend(
     }
 }
 
-/// Mean gap per element, `(1/Δi)∫(uz − δz + x²/2R)`, for every element.
-pub(super) fn gaps(input: &NormalInput, pressure: &[f64], charge: &[f64], approach: f64) -> Vec<f64> {
+/// Mean gap per element, `(1/Δi)∫(uz − δz + x²/2R)`, outside the contact (`contact[i]`
+/// false); 0 on it, where the contact equations make it zero. p and g vanish outside the
+/// contact, so only the columns of the contact's span enter.
+pub(super) fn gaps(
+    input: &NormalInput,
+    (pressure, charge, approach): (&[f64], &[f64], f64),
+    contact: &[bool],
+) -> Vec<f64> {
     let c = input.coefficients;
     let n = input.mesh.len();
+    let first = contact.iter().position(|&x| x).unwrap_or(0);
+    let last = contact.iter().rposition(|&x| x).map_or(0, |i| i + 1);
+    let support = first..last.max(first);
+    let outside: Vec<bool> = contact.iter().map(|&x| !x).collect();
     let mut lp = vec![0.0; n];
-    input.influence.log_apply(pressure, &mut lp);
+    input
+        .influence
+        .log_apply_rows(pressure, support.clone(), &outside, &mut lp);
     let mut lg = vec![0.0; n];
     if c.electric.is_some() {
-        input.influence.log_apply(charge, &mut lg);
+        input
+            .influence
+            .log_apply_rows(charge, support, &outside, &mut lg);
     }
     let mut sq = vec![0.0; n];
     if c.coupled {
@@ -170,6 +188,9 @@ pub(super) fn gaps(input: &NormalInput, pressure: &[f64], charge: &[f64], approa
             let (x1, x2) = (input.mesh.edges[i], input.mesh.edges[i + 1]);
             let w = x2 - x1;
             let uz = -(c.y22 / PI) * lp[i] - (y23 / PI) * lg[i] + 0.5 * c.w12 * sq[i];
+            if contact[i] {
+                return 0.0;
+            }
             (uz - w * approach + c.profile.gap_integral(x1, x2)) / w
         })
         .collect()
