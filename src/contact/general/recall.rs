@@ -86,7 +86,24 @@ impl Recall {
         let solver = Arc::new(Solver::new(model, mesh, options));
         self.solvers.push_front(Arc::clone(&solver));
         self.solvers.truncate(SOLVERS);
+        // A step on a solver no longer kept can never be recalled (a solver is only ever
+        // handed out again from `solvers`), and would keep that solver's matrices alive.
+        let kept = &self.solvers;
+        self.steps
+            .retain(|step| kept.iter().any(|s| Arc::ptr_eq(s, &step.solver)));
         solver
+    }
+
+    /// The distinct solvers alive in the recall (kept, or held by a remembered step).
+    #[cfg(test)]
+    fn solvers_alive(&self) -> usize {
+        let mut alive: Vec<&Arc<Solver>> = self.solvers.iter().collect();
+        for step in &self.steps {
+            if !alive.iter().any(|s| Arc::ptr_eq(s, &step.solver)) {
+                alive.push(&step.solver);
+            }
+        }
+        alive.len()
     }
 
     /// `solver.step(from, loads)`, or the remembered result of the same step.
@@ -225,6 +242,20 @@ mod tests {
         let nearby = perturbed(&state, 1e-14);
         recall.step(&solver, &nearby, back).unwrap();
         assert_eq!(recall.recalled_steps, 1, "a state 1e−14 away is solved");
+
+        // Steps on many meshes (each phase start of a history has its own): no more solvers
+        // stay alive than are kept, whatever the steps remembered.
+        for k in 1..=2 * SOLVERS {
+            let other = Mesh::uniform(-1.25 * 4.2e-5, 1.25 * 4.2e-5, 200 + k);
+            let solver = recall.solver(&model, other.clone(), Options::default());
+            let from = GeneralState::unloaded(other);
+            let pressed = Loads {
+                tangential: 0.0,
+                ..back
+            };
+            recall.step(&solver, &from, pressed).unwrap();
+        }
+        assert_eq!(recall.solvers_alive(), SOLVERS);
 
         let mut off = Recall::new(false);
         let one = off.solver(&model, mesh.clone(), Options::default());
