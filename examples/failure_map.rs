@@ -554,6 +554,9 @@ fn short_failure(f: &SolveFailure) -> String {
         SolveFailure::NoAdmissibleState { reason } => {
             format!("no admissible state: {}", without_numbers(reason))
         }
+        SolveFailure::NeitherSolver { general, .. } => {
+            format!("neither solver; general: {}", short_failure(general))
+        }
     }
 }
 

@@ -6,6 +6,9 @@
 //! - Zhou & Lee (2012), frictionless conducting punch on a piezoelectric half-plane, in the
 //!   form derived in [`crate::contact`]: Hertz with `Y* = y22 − y23²/y33`, and
 //!   `g(x) = k p(x) + (Γ − kP)/(π √(a² − x²))`, `k = −y23/y33`.
+//! - The flat punch with rounded corners (flat half-width b, corner radius R; Ciavarella,
+//!   Hills and Monno 1998, *Proc. IMechE C* 212, 319–328): [`FlatRounded`], its load, peak
+//!   pressure and, on an uncoupled half-plane, the Cattaneo-type stick zone.
 
 use std::f64::consts::PI;
 
@@ -214,5 +217,76 @@ impl CattaneoMindlin {
     pub fn unloading_displacement(&self, q_star: f64, q: f64, y11: f64, d: f64) -> f64 {
         self.loading_displacement(q_star, y11, d)
             - 2.0 * self.loading_displacement((q_star - q) / 2.0, y11, d)
+    }
+}
+
+/// The frictionless flat punch with rounded corners on a half-plane of pressure compliance Y*
+/// ([`crate::contact::Profile::FlatRounded`]): with `φ0 = arcsin(b/a)` for a contact
+/// `|x| ≤ a`, `a > b`, from `P = (1/Y*)∫ x h'(x)/√(a² − x²) dx` and
+/// `p(x) = (√(a² − x²)/(π Y*)) ∫ h'(s)/(√(a² − s²)(s − x)) ds` (bounded at both ends),
+///
+/// ```text
+/// P(a) = a² (π/2 − φ0 − sin φ0 cos φ0)/(R Y*)
+/// p(0) = (2a/(π R Y*)) [π/2 − φ0 − sin φ0 ln((1 + cos φ0)/sin φ0)]
+/// ```
+///
+/// Hertz's at b = 0. Under a tangential load Q < ηP from zero at constant P, on an uncoupled
+/// half-plane (Dundurs' β = 0), the shear traction is `q = η(p(x; a) − p(x; c))` (Ciavarella's
+/// and Jäger's superposition of the same punch's pressures), so the stick zone `|x| < c`
+/// carries `P(c) = P − |Q|/η`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlatRounded {
+    /// Flat half-width b (m).
+    pub half_flat: f64,
+    /// Corner radius R (m).
+    pub radius: f64,
+    /// Pressure compliance Y* (1/Pa).
+    pub compliance: f64,
+}
+
+impl FlatRounded {
+    /// The load P (N/m) that a contact of half-width `a` (m) carries; 0 for `a ≤ b`.
+    pub fn load(&self, a: f64) -> f64 {
+        if a <= self.half_flat {
+            return 0.0;
+        }
+        let phi = (self.half_flat / a).asin();
+        a * a * (PI / 2.0 - phi - phi.sin() * phi.cos()) / (self.radius * self.compliance)
+    }
+
+    /// The contact half-width (m) under `load` (N/m): the root of [`Self::load`], which rises
+    /// monotonically from b, bracketed and found by bisection to round-off.
+    pub fn half_width(&self, load: f64) -> f64 {
+        let hertz = Hertz::new(load, self.radius, self.compliance).half_width;
+        let (mut lo, mut hi) = (self.half_flat, self.half_flat + hertz);
+        while self.load(hi) < load {
+            hi = self.half_flat + 2.0 * (hi - self.half_flat);
+        }
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if self.load(mid) < load {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        0.5 * (lo + hi)
+    }
+
+    /// The pressure at the centre (Pa) of a contact of half-width `a`.
+    pub fn centre_pressure(&self, a: f64) -> f64 {
+        let phi = (self.half_flat / a).asin();
+        let log = if phi > 0.0 {
+            phi.sin() * ((1.0 + phi.cos()) / phi.sin()).ln()
+        } else {
+            0.0
+        };
+        2.0 * a / (PI * self.radius * self.compliance) * (PI / 2.0 - phi - log)
+    }
+
+    /// The stick-zone half-width c (m) after a tangential load Q from zero at constant `load`
+    /// P with friction η, on an uncoupled half-plane: `P(c) = P − |Q|/η`.
+    pub fn stick_half_width(&self, load: f64, friction: f64, q: f64) -> f64 {
+        self.half_width(load - q.abs() / friction)
     }
 }

@@ -82,6 +82,15 @@ pub enum SolveFailure {
         /// Why.
         reason: String,
     },
+    /// Neither solver gave the state of a normal loading: the spectral solver's failure, then
+    /// the general solver's ([`crate::history::NormalEnd`]).
+    #[error("{spectral}; the general solver, loading by steps: {general}")]
+    NeitherSolver {
+        /// The spectral solver's failure.
+        spectral: Box<SolveFailure>,
+        /// The general solver's failure.
+        general: Box<SolveFailure>,
+    },
 }
 
 /// Why the surface response of a half-plane could not be computed from its constants

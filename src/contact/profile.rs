@@ -6,10 +6,24 @@
 //! uz(x) = δ0 − h(x − x_p),   ∂uz/∂x = −h'(x − x_p)
 //! ```
 //!
-//! where δ0 is the approach and x_p the punch axis in the frame of the solid. Only the cylinder
-//! exists so far, `h(x) = x²/(2R)`, `h'(x) = x/R`: its constant curvature 1/R makes the
-//! frictionless pressure the square-root ellipse and normal loading self-similar (Spence), which
-//! the spectral solver of the paper relies on ([`Profile::curvature`]).
+//! where δ0 is the approach and x_p the punch axis in the frame of the solid.
+//!
+//! - The cylinder, `h(x) = x²/(2R)`, `h'(x) = x/R`: its constant curvature 1/R makes the
+//!   frictionless pressure the square-root ellipse and normal loading self-similar (Spence),
+//!   which the spectral solver of the paper relies on ([`Profile::curvature`]).
+//! - The flat punch with rounded corners, the standard fretting-fatigue pad: a flat face of
+//!   half-width b and corners of radius R, `h(x) = (|x| − b)²/(2R)` for `|x| > b` and 0 on the
+//!   flat. Its contact is not self-similar; the general solver takes it
+//!   ([`crate::history::NormalEnd`]). For a contact `|x| ≤ a`, `a > b`, `φ0 = arcsin(b/a)`,
+//!   the frictionless half-plane with pressure compliance Y* carries (Ciavarella, Hills and
+//!   Monno 1998, from `P = (1/Y*)∫ x h'(x)/√(a² − x²) dx`)
+//!
+//! ```text
+//! P = a² (π/2 − φ0 − sin φ0 cos φ0)/(R Y*),
+//! p(0) = (2a/(π R Y*)) [π/2 − φ0 − sin φ0 ln((1 + cos φ0)/sin φ0)]
+//! ```
+//!
+//! which are Hertz's `P = πa²/(2RY*)` and `p0 = a/(RY*)` at b = 0.
 
 use serde::{Deserialize, Serialize};
 
@@ -22,6 +36,13 @@ pub enum Profile {
         /// Radius R (m).
         radius: f64,
     },
+    /// A flat face of half-width b (m) with corners of radius R (m), parabolic beyond it.
+    FlatRounded {
+        /// Half-width b of the flat face (m).
+        half_flat: f64,
+        /// Corner radius R (m).
+        radius: f64,
+    },
 }
 
 impl Profile {
@@ -30,42 +51,66 @@ impl Profile {
         Self::Cylinder { radius }
     }
 
+    /// A flat punch of half-width `half_flat` with corners of radius `radius` (m).
+    pub fn flat_rounded(half_flat: f64, radius: f64) -> Self {
+        Self::FlatRounded { half_flat, radius }
+    }
+
+    /// Whether the spectral solver of the paper takes the profile (the cylinder only).
+    pub fn is_cylinder(&self) -> bool {
+        matches!(self, Self::Cylinder { .. })
+    }
+
+    /// The half-width of the flat face (m; 0 for the cylinder).
+    pub fn flat_half_width(&self) -> f64 {
+        self.parabola().0
+    }
+
+    /// The distance from the axis beyond which the profile is the parabola `(|x| − b)²/(2R)`,
+    /// and R: `(0, R)` for the cylinder.
+    fn parabola(&self) -> (f64, f64) {
+        match *self {
+            Self::Cylinder { radius } => (0.0, radius),
+            Self::FlatRounded { half_flat, radius } => (half_flat, radius),
+        }
+    }
+
     /// The height h(x) of the surface above its lowest point at x from the axis (m).
     pub fn gap(&self, x: f64) -> f64 {
-        match *self {
-            Self::Cylinder { radius } => x * x / (2.0 * radius),
-        }
+        let (b, radius) = self.parabola();
+        let d = (x.abs() - b).max(0.0);
+        d * d / (2.0 * radius)
     }
 
     /// `∫ h dx` from `x1` to `x2` (m²): the mean gap of an element of the general solver times
     /// its width.
     pub fn gap_integral(&self, x1: f64, x2: f64) -> f64 {
-        match *self {
-            Self::Cylinder { radius } => (x2.powi(3) - x1.powi(3)) / (6.0 * radius),
+        let (b, radius) = self.parabola();
+        // An antiderivative, odd in x: sign(x) max(|x| − b, 0)³/(6R).
+        let f = |x: f64| x.signum() * (x.abs() - b).max(0.0).powi(3) / (6.0 * radius);
+        match self {
+            Self::Cylinder { .. } => (x2.powi(3) - x1.powi(3)) / (6.0 * radius),
+            Self::FlatRounded { .. } => f(x2) - f(x1),
         }
     }
 
     /// The slope h'(x) (–).
     pub fn slope(&self, x: f64) -> f64 {
-        match *self {
-            Self::Cylinder { radius } => x / radius,
-        }
+        let (b, radius) = self.parabola();
+        x.signum() * (x.abs() - b).max(0.0) / radius
     }
 
     /// `h''/Y*` for a pressure compliance Y* (1/Pa): the scale of the pressure's unit response
-    /// on the collocation grid (eq. 52's right-hand side).
+    /// on the collocation grid (eq. 52's right-hand side; the spectral solver's profile).
     pub fn pressure_scale(&self, compliance: f64) -> f64 {
-        match *self {
-            Self::Cylinder { radius } => 1.0 / (radius * compliance),
-        }
+        1.0 / (self.parabola().1 * compliance)
     }
 
-    /// The curvature h'' (1/m), constant for the profiles that the spectral solver takes: the
-    /// pressure then scales with one unit response of the collocation grid.
+    /// The curvature h'' (1/m): constant for the cylinder, which the spectral solver takes
+    /// (the pressure then scales with one unit response of the collocation grid); of the
+    /// rounded corners for the flat punch (0 on its flat).
     pub fn curvature(&self) -> f64 {
-        match *self {
-            Self::Cylinder { radius } => 1.0 / radius,
-        }
+        1.0 / self.parabola().1
     }
 }
 
@@ -90,5 +135,31 @@ mod tests {
         let (x1, x2) = (-1e-5, 3e-5);
         let simpson = (x2 - x1) / 6.0 * (p.gap(x1) + 4.0 * p.gap(0.5 * (x1 + x2)) + p.gap(x2));
         assert!((p.gap_integral(x1, x2) - simpson).abs() <= 1e-15 * simpson);
+    }
+
+    /// The flat punch with rounded corners: zero on the flat, the corner parabola beyond it,
+    /// continuous in h and h'; its integral against a fine midpoint rule across the corners.
+    #[test]
+    fn the_flat_punch_is_flat_then_parabolic_and_its_integral_is_exact() {
+        let (b, radius) = (1e-5, 0.01);
+        let p = Profile::flat_rounded(b, radius);
+        assert!(!p.is_cylinder() && Profile::cylinder(radius).is_cylinder());
+        for x in [-0.9 * b, 0.0, 0.5 * b, b] {
+            assert!(p.gap(x).abs() < f64::MIN_POSITIVE && p.slope(x).abs() < f64::MIN_POSITIVE);
+        }
+        for x in [-3e-5_f64, 1.5e-5, 4e-5] {
+            let d = x.abs() - b;
+            assert!((p.gap(x) - d * d / (2.0 * radius)).abs() <= 1e-15 * p.gap(x));
+            let step = 1e-9;
+            let slope = (p.gap(x + step) - p.gap(x - step)) / (2.0 * step);
+            assert!((slope - p.slope(x)).abs() <= 1e-6 * p.slope(x).abs());
+        }
+        for (x1, x2) in [(-3e-5, 2e-5), (-5e-6, 5e-6), (5e-6, 3e-5)] {
+            let n = 200_000;
+            let h = (x2 - x1) / n as f64;
+            let midpoint: f64 = (0..n).map(|i| p.gap(x1 + (i as f64 + 0.5) * h) * h).sum();
+            let exact = p.gap_integral(x1, x2);
+            assert!((exact - midpoint).abs() <= 1e-8 * midpoint.max(1e-30), "{x1} {x2}");
+        }
     }
 }

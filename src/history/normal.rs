@@ -10,7 +10,9 @@
 //! ([`crate::contact::normal::solve_normal`]: one central stick zone between two slip zones).
 //! Where that form holds no admissible state, and the choice of solver is not
 //! [`SolverChoice::Spectral`], the general solver loads the contact by steps along the same
-//! path ([`load_by_steps`]) and the history starts from its state. That happens at small η
+//! path ([`load_by_steps`]) and the history starts from its state; so it does for a punch
+//! that is not a cylinder (the flat punch with rounded corners, [`crate::contact::Profile`]),
+//! whose contact is not self-similar. That happens at small η
 //! in a coupled contact: PZT-4 under a conducting punch with Γ = 2e−7 C/m (below Γ1) and
 //! η = 0.1 ends with the slip near each contact end running the other way, beyond a second
 //! stick zone (five zones in all, two changes of the slip direction on each side). Every step
@@ -82,16 +84,23 @@ impl NormalEnd {
         solver: SolverChoice,
         inner: f64,
     ) -> Result<Self, SolveFailure> {
-        let failure = match solve_normal(model, disc, normal_load, NormalOptions::default()) {
-            Ok(normal) => return Ok(Self::Spectral(Box::new(normal))),
-            Err(failure) => failure,
+        let failure = if !model.profile.is_cylinder() {
+            SolveFailure::NoAdmissibleState {
+                reason: "the spectral solver takes a cylindrical punch only".into(),
+            }
+        } else {
+            match solve_normal(model, disc, normal_load, NormalOptions::default()) {
+                Ok(normal) => return Ok(Self::Spectral(Box::new(normal))),
+                Err(failure) => failure,
+            }
         };
         if solver == SolverChoice::Spectral {
             return Err(failure);
         }
         let (run, mut loading) = load_by_steps(model, normal_load, inner).map_err(|general| {
-            SolveFailure::NoAdmissibleState {
-                reason: format!("{failure}; the general solver, loading by steps: {general}"),
+            SolveFailure::NeitherSolver {
+                spectral: Box::new(failure.clone()),
+                general: Box::new(general),
             }
         })?;
         loading.spectral_failure = failure.to_string();
@@ -157,7 +166,15 @@ pub fn load_by_steps(
     let mut half = 1.6;
     let first = loop {
         let probe = Solver::new(model, Mesh::uniform(-1.0, 1.0, 2), Options::default());
-        let a = probe.hertz_half_width(full);
+        let a = model.profile.flat_half_width() + probe.hertz_half_width(full);
+        if !(a.is_normal() && (half * a).is_normal() && (END_SIZE * a).is_normal()) {
+            return Err(SolveFailure::NoAdmissibleState {
+                reason: format!(
+                    "the contact half-width of P = {normal_load:e} N/m ({a:e} m by Hertz) is out \
+                     of the range of floating-point numbers"
+                ),
+            });
+        }
         let focus = [Focus {
             at: a,
             size: 2e-3 * a,
@@ -175,7 +192,7 @@ pub fn load_by_steps(
     // Second pass, on the mesh of the first pass's zones.
     let solver = Arc::new(Solver::new(
         model,
-        mesh_of_zones(&first, inner),
+        mesh_of_zones(&first, model.profile.flat_half_width(), inner),
         Options::default(),
     ));
     let (state, loading) = steps(&solver, full, RATIO)?;
@@ -184,14 +201,21 @@ pub fn load_by_steps(
 
 /// A symmetric mesh for the state of a normal loading: band `±1.25a`, elements of
 /// [`END_SIZE`]·a at the contact ends and [`STICK_SIZE`]·a at the ends of its zones (those
-/// more than one element long), growing by [`GROWTH`] up to `inner`·a.
-fn mesh_of_zones(state: &GeneralState, inner: f64) -> Mesh {
+/// more than one element long) and at the corners `±flat` of a flat punch (where h'' jumps),
+/// growing by [`GROWTH`] up to `inner`·a.
+fn mesh_of_zones(state: &GeneralState, flat: f64, inner: f64) -> Mesh {
     let (lo, hi) = state.contact_extent().expect("a loaded contact");
     let a = 0.5 * (hi - lo);
     let mut focus = vec![Focus {
         at: a,
         size: END_SIZE * a,
     }];
+    if flat > 0.0 && flat < a {
+        focus.push(Focus {
+            at: flat,
+            size: STICK_SIZE * a,
+        });
+    }
     let zones = state.zones();
     for pair in zones.windows(2) {
         let at = pair[0].2.abs();

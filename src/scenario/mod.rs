@@ -212,16 +212,15 @@ fn build(
     history: Option<crate::history::LoadHistory>,
     time_tolerance: f64,
 ) -> Result<Scenario, Vec<Issue>> {
-    let model = ContactModel::try_new(
-        material,
-        Profile::cylinder(raw.punch.radius),
-        raw.friction,
-        electrode,
-    )
-    .map_err(|failure| vec![material_issue(&raw.material, &failure)])?
-    .with_reference_distance(raw.reference_distance)
-    .with_coupling(raw.coupling)
-    .with_stick_end_kinks(raw.numerics.stick_end_kinks);
+    let profile = match raw.punch.flat_half_width {
+        Some(b) if b > 0.0 => Profile::flat_rounded(b, raw.punch.radius),
+        _ => Profile::cylinder(raw.punch.radius),
+    };
+    let model = ContactModel::try_new(material, profile, raw.friction, electrode)
+        .map_err(|failure| vec![material_issue(&raw.material, &failure)])?
+        .with_reference_distance(raw.reference_distance)
+        .with_coupling(raw.coupling)
+        .with_stick_end_kinks(raw.numerics.stick_end_kinks);
     let history = history.map(|mut h| {
         insert_snapshot_points(&mut h, &raw.output.snapshots, time_tolerance);
         h

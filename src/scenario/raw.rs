@@ -207,8 +207,12 @@ pub enum RawMaterial {
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawPunch {
-    /// Radius R (m), > 0.
+    /// Radius R (m), > 0: of the cylinder, or of the corners of a flat punch.
     pub radius: f64,
+    /// Half-width b (m) of a flat face with corners of radius R (the fretting-fatigue pad);
+    /// absent or 0 for the cylinder.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flat_half_width: Option<f64>,
     /// Electric boundary condition (default: none, for an elastic half-plane).
     #[serde(default)]
     pub electrode: RawElectrode,

@@ -117,6 +117,19 @@ pub(super) fn surface_response(
 /// Punch radius, loads, datum distance and friction.
 pub(super) fn validate_loads(issues: &mut Vec<Issue>, raw: &RawScenario) {
     positive(issues, "punch.radius", raw.punch.radius, "m");
+    if let Some(b) = raw.punch.flat_half_width {
+        if !(b.is_finite() && b >= 0.0) {
+            issues.push(Issue::new(
+                "punch.flat_half_width",
+                format!("{b} m is invalid; it must be finite and ≥ 0"),
+            ));
+        } else if b > 0.0 && raw.numerics.solver == crate::history::SolverChoice::Spectral {
+            issues.push(Issue::new(
+                "numerics.solver",
+                "\"spectral\" is invalid with a flat punch (`punch.flat_half_width` > 0); it must be \"auto\" or \"general\" (the spectral solver takes a cylinder only)",
+            ));
+        }
+    }
     positive(issues, "normal_load", raw.normal_load, "N/m");
     positive(issues, "reference_distance", raw.reference_distance, "m");
     if !(raw.friction.is_finite() && raw.friction >= 0.0) {

@@ -104,6 +104,39 @@ fn every_problem_is_collected() {
     );
 }
 
+/// A flat punch: its half-width must be finite and ≥ 0, and the spectral solver alone cannot
+/// take it; 0 is the cylinder.
+#[test]
+fn flat_punch_rules() {
+    let flat = |b: &str, solver: &str| {
+        DEFAULT_SCENARIO
+            .replace(
+                "\"radius\": 0.06",
+                &format!("\"radius\": 0.06, \"flat_half_width\": {b}"),
+            )
+            .replace(
+                "\"friction\": 0.3",
+                &format!("\"friction\": 0.3, \"numerics\": {{\"solver\": \"{solver}\"}}"),
+            )
+    };
+    let messages =
+        |text: &str| -> Vec<String> { issues(text).iter().map(|i| i.to_string()).collect() };
+    assert_eq!(
+        messages(&flat("-0.001", "auto")),
+        ["`punch.flat_half_width` = -0.001 m is invalid; it must be finite and ≥ 0"]
+    );
+    assert_eq!(
+        messages(&flat("1e-5", "spectral")),
+        [
+            "`numerics.solver` = \"spectral\" is invalid with a flat punch (`punch.flat_half_width` > 0); it must be \"auto\" or \"general\" (the spectral solver takes a cylinder only)"
+        ]
+    );
+    let sc = validate(parse(&flat("1e-5", "auto"), Path::new("t")).unwrap()).unwrap();
+    assert_eq!(sc.model.profile, Profile::flat_rounded(1e-5, 0.06));
+    let sc = validate(parse(&flat("0", "spectral"), Path::new("t")).unwrap()).unwrap();
+    assert!(sc.model.profile.is_cylinder());
+}
+
 #[test]
 fn electric_load_on_elastic_material_is_rejected() {
     let text = r#"{"material": {"kind": "elastic", "shear_modulus": 27.3e9, "poisson_ratio": 0.3},

@@ -762,3 +762,71 @@ fn normal_load_lowered_at_constant_q_follows_cattaneo_mindlin_of_the_current_loa
     assert!((c - c_exact * a).abs() <= 1.05 * width_at(&mesh, c_exact * a));
     assert!(l1 < 1e-4, "{l1:e}");
 }
+
+/// The flat punch with rounded corners (Ciavarella, Hills and Monno 1998;
+/// [`crate::analytical::FlatRounded`]) on the uncoupled half-plane (ν = 0.5), flat half-width
+/// b = 1e−5 m, corner radius 10 mm, P = 2240 N/m: the contact half-width and the pressure at
+/// the centre against the closed forms, and after Q = 0.5 ηP (η = 0.3) the Cattaneo-type stick
+/// zone, `P(c) = P − Q/η`, each at two meshes.
+#[test]
+fn flat_punch_with_rounded_corners_ciavarella_half_width_centre_pressure_and_stick_zone() {
+    use crate::analytical::FlatRounded;
+    let (b, radius, p, eta) = (1e-5, 10e-3, 2240.0, 0.3);
+    let constants = IsotropicConstants {
+        shear_modulus: ALUMINIUM.shear_modulus,
+        poisson_ratio: 0.5,
+    };
+    let model = ContactModel::new(
+        Material::Elastic(constants),
+        Profile::flat_rounded(b, radius),
+        eta,
+        Electrode::None,
+    );
+    let exact = FlatRounded {
+        half_flat: b,
+        radius,
+        compliance: model.compliance.y22,
+    };
+    let a = exact.half_width(p);
+    let q = 0.5 * eta * p;
+    let c = exact.stick_half_width(p, eta, q);
+    assert!((exact.load(a) / p - 1.0).abs() < 1e-12 && c > b && c < a);
+    for size in [2e-3, 1e-3] {
+        let focus = [
+            Focus { at: a, size: size * a },
+            Focus { at: c, size: size * a },
+            Focus { at: b, size: 4.0 * size * a },
+        ];
+        let mesh = Mesh::symmetric(1.1 * a, &focus, 1.05, 0.01 * a);
+        let solver = Solver::new(&model, mesh.clone(), Options::default());
+        let (pressed, _) = solver
+            .step(&GeneralState::unloaded(mesh.clone()), loads(p, 0.0))
+            .unwrap();
+        let (lo, hi) = pressed.contact_extent().unwrap();
+        let centre = (0..mesh.len())
+            .find(|&i| mesh.edges[i] <= 0.0 && 0.0 < mesh.edges[i + 1])
+            .unwrap();
+        let p0 = exact.centre_pressure(a);
+        let (sheared, _) = solver.step(&pressed, loads(p, q)).unwrap();
+        let stick: Vec<_> = sheared
+            .zones()
+            .into_iter()
+            .filter(|z| z.0 == ElementState::Stick)
+            .collect();
+        eprintln!(
+            "flat punch, elements {size:e} a: a {:.6e} m (exact {a:.6e}), p(0) {:.6e} Pa (exact {p0:.6e}), stick {:?} (exact c = {c:.6e} m, c/a = {:.5})",
+            0.5 * (hi - lo),
+            pressed.pressure[centre],
+            stick.iter().map(|z| (z.1, z.2)).collect::<Vec<_>>(),
+            c / a
+        );
+        // Measured: Δa = −3.3e−4 a and +3.0e−4 a (end elements 2e−3 a and 1e−3 a), p(0) within
+        // 1.7e−5 (the mean of the centre element, 1e−2 a, at both meshes), Δc = −3.2e−4 a and
+        // +1.7e−4 a (elements of the mesh's size at c).
+        assert!((hi - a).abs() <= width_at(&mesh, a) && (lo + a).abs() <= width_at(&mesh, -a));
+        assert!((pressed.pressure[centre] / p0 - 1.0).abs() < 1e-4);
+        assert_eq!(stick.len(), 1);
+        let (s1, s2) = (stick[0].1, stick[0].2);
+        assert!((s2 - c).abs() <= width_at(&mesh, c) && (s1 + c).abs() <= width_at(&mesh, -c));
+    }
+}
