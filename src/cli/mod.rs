@@ -151,8 +151,15 @@ fn run(
         }
     };
     let n = &result.solution.summary.normal_loading;
+    let by = match n.solver {
+        crate::history::SolverKind::Spectral => String::new(),
+        crate::history::SolverKind::General => format!(
+            " (general solver: {} stick and {} slip zones)",
+            n.zones.stick, n.zones.slip
+        ),
+    };
     println!(
-        "{}: a = {:.6e} m, b/a = {:.6}, C = {:.6e} 1/m, p0 = {:.6e} Pa -> {}",
+        "{}: a = {:.6e} m, b/a = {:.6}, C = {:.6e} 1/m, p0 = {:.6e} Pa{by} -> {}",
         sc.name,
         n.half_width,
         n.stick_ratio,
