@@ -290,3 +290,22 @@ impl FlatRounded {
         self.half_width(load - q.abs() / friction)
     }
 }
+
+/// Wallis's integral `W(n) = ∫₀^{π/2} sinⁿφ dφ` for real n ≥ 1, by 64-point Gauss–Legendre
+/// on the smooth integrand (`W(1) = 1`, `W(2) = π/4`, `W(3) = 2/3` to round-off).
+pub fn wallis(n: f64) -> f64 {
+    let (nodes, weights) = crate::quadrature::gauss_legendre(64);
+    let half = PI / 4.0;
+    nodes
+        .iter()
+        .zip(&weights)
+        .map(|(x, w)| w * half * (half * (1.0 + x)).sin().powf(n))
+        .sum()
+}
+
+/// The frictionless contact half-width (m) of the power-law punch `h = A|x|ⁿ` under load P
+/// (N/m) on a half-plane of pressure compliance Y*: `P = 2nA aⁿ W(n)/Y*` (from
+/// `P = (1/Y*)∫ x h'(x)/√(a² − x²) dx`, x = a sin φ), Hertz's at n = 2, A = 1/(2R).
+pub fn power_law_half_width(coefficient: f64, exponent: f64, load: f64, compliance: f64) -> f64 {
+    (load * compliance / (2.0 * exponent * coefficient * wallis(exponent))).powf(1.0 / exponent)
+}

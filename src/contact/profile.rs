@@ -24,6 +24,13 @@
 //! ```
 //!
 //! which are Hertz's `P = πa²/(2RY*)` and `p0 = a/(RY*)` at b = 0.
+//! - The power law `h(x) = A|x|ⁿ`, n ≥ 1 (convex; n = 2 with A = 1/(2R) is the cylinder):
+//!   `P = 2nA aⁿ W(n)/Y*` with Wallis's `W(n) = ∫₀^{π/2} sinⁿφ dφ`
+//!   ([`crate::analytical::power_law_half_width`]). The general solver takes it too.
+//!
+//! On an uncoupled half-plane the Cattaneo-type stick zone of a symmetric punch under Q from
+//! zero at constant P carries the load `P(c) = P − |Q|/η` of the same punch (Jäger's and
+//! Ciavarella's superposition): `c/a = (1 − |Q|/(ηP))^(1/n)` for the power law.
 
 use serde::{Deserialize, Serialize};
 
@@ -43,6 +50,13 @@ pub enum Profile {
         /// Corner radius R (m).
         radius: f64,
     },
+    /// A power law `h = A|x|ⁿ`, n ≥ 1.
+    PowerLaw {
+        /// A (m^(1−n)).
+        coefficient: f64,
+        /// n.
+        exponent: f64,
+    },
 }
 
 impl Profile {
@@ -56,61 +70,118 @@ impl Profile {
         Self::FlatRounded { half_flat, radius }
     }
 
+    /// The power law `h = coefficient·|x|^exponent`.
+    pub fn power_law(coefficient: f64, exponent: f64) -> Self {
+        Self::PowerLaw {
+            coefficient,
+            exponent,
+        }
+    }
+
     /// Whether the spectral solver of the paper takes the profile (the cylinder only).
     pub fn is_cylinder(&self) -> bool {
         matches!(self, Self::Cylinder { .. })
     }
 
-    /// The half-width of the flat face (m; 0 for the cylinder).
+    /// The half-width of the flat face (m; 0 but for the flat punch).
     pub fn flat_half_width(&self) -> f64 {
-        self.parabola().0
-    }
-
-    /// The distance from the axis beyond which the profile is the parabola `(|x| − b)²/(2R)`,
-    /// and R: `(0, R)` for the cylinder.
-    fn parabola(&self) -> (f64, f64) {
         match *self {
-            Self::Cylinder { radius } => (0.0, radius),
-            Self::FlatRounded { half_flat, radius } => (half_flat, radius),
+            Self::FlatRounded { half_flat, .. } => half_flat,
+            _ => 0.0,
         }
     }
 
     /// The height h(x) of the surface above its lowest point at x from the axis (m).
     pub fn gap(&self, x: f64) -> f64 {
-        let (b, radius) = self.parabola();
-        let d = (x.abs() - b).max(0.0);
-        d * d / (2.0 * radius)
+        match *self {
+            Self::Cylinder { radius } => x * x / (2.0 * radius),
+            Self::FlatRounded { half_flat, radius } => {
+                let d = (x.abs() - half_flat).max(0.0);
+                d * d / (2.0 * radius)
+            }
+            Self::PowerLaw {
+                coefficient,
+                exponent,
+            } => coefficient * x.abs().powf(exponent),
+        }
     }
 
     /// `∫ h dx` from `x1` to `x2` (m²): the mean gap of an element of the general solver times
     /// its width.
     pub fn gap_integral(&self, x1: f64, x2: f64) -> f64 {
-        let (b, radius) = self.parabola();
-        // An antiderivative, odd in x: sign(x) max(|x| − b, 0)³/(6R).
-        let f = |x: f64| x.signum() * (x.abs() - b).max(0.0).powi(3) / (6.0 * radius);
-        match self {
-            Self::Cylinder { .. } => (x2.powi(3) - x1.powi(3)) / (6.0 * radius),
-            Self::FlatRounded { .. } => f(x2) - f(x1),
+        // Antiderivatives, odd in x.
+        let f = |x: f64| match *self {
+            Self::Cylinder { radius } => x.powi(3) / (6.0 * radius),
+            Self::FlatRounded { half_flat, radius } => {
+                x.signum() * (x.abs() - half_flat).max(0.0).powi(3) / (6.0 * radius)
+            }
+            Self::PowerLaw {
+                coefficient,
+                exponent,
+            } => x.signum() * coefficient * x.abs().powf(exponent + 1.0) / (exponent + 1.0),
+        };
+        match *self {
+            Self::Cylinder { radius } => (x2.powi(3) - x1.powi(3)) / (6.0 * radius),
+            _ => f(x2) - f(x1),
         }
     }
 
     /// The slope h'(x) (–).
     pub fn slope(&self, x: f64) -> f64 {
-        let (b, radius) = self.parabola();
-        x.signum() * (x.abs() - b).max(0.0) / radius
+        match *self {
+            Self::Cylinder { radius } => x / radius,
+            Self::FlatRounded { half_flat, radius } => {
+                x.signum() * (x.abs() - half_flat).max(0.0) / radius
+            }
+            Self::PowerLaw {
+                coefficient,
+                exponent,
+            } => x.signum() * coefficient * exponent * x.abs().powf(exponent - 1.0),
+        }
     }
 
     /// `h''/Y*` for a pressure compliance Y* (1/Pa): the scale of the pressure's unit response
-    /// on the collocation grid (eq. 52's right-hand side; the spectral solver's profile).
+    /// on the collocation grid (eq. 52's right-hand side; the spectral solver's cylinder).
     pub fn pressure_scale(&self, compliance: f64) -> f64 {
-        1.0 / (self.parabola().1 * compliance)
+        1.0 / (self.radius() * compliance)
     }
 
-    /// The curvature h'' (1/m): constant for the cylinder, which the spectral solver takes
-    /// (the pressure then scales with one unit response of the collocation grid); of the
-    /// rounded corners for the flat punch (0 on its flat).
+    /// The curvature h'' (1/m): the cylinder's, constant, which the spectral solver relies on
+    /// (the pressure then scales with one unit response of the collocation grid); the flat
+    /// punch's corners'; for the power law, `2A`, its value at n = 2 (the spectral solver never
+    /// takes these two; [`Self::frictionless_half_width`] is the general solver's guess).
     pub fn curvature(&self) -> f64 {
-        1.0 / self.parabola().1
+        1.0 / self.radius()
+    }
+
+    /// 1/h'' of [`Self::curvature`] (m).
+    fn radius(&self) -> f64 {
+        match *self {
+            Self::Cylinder { radius } | Self::FlatRounded { radius, .. } => radius,
+            Self::PowerLaw { coefficient, .. } => 1.0 / (2.0 * coefficient),
+        }
+    }
+
+    /// The frictionless contact half-width (m) under load P (N/m) on a half-plane of pressure
+    /// compliance Y* (1/Pa): Hertz's for the cylinder, [`crate::analytical::FlatRounded`]'s
+    /// for the flat punch, and for the power law, from `P = (1/Y*)∫ x h'(x)/√(a² − x²) dx`,
+    /// `P = 2nA aⁿ W(n)/Y*` with Wallis's integral `W(n) = ∫₀^{π/2} sinⁿφ dφ`.
+    pub fn frictionless_half_width(&self, load: f64, compliance: f64) -> f64 {
+        match *self {
+            Self::Cylinder { radius } => {
+                crate::analytical::Hertz::new(load, radius, compliance).half_width
+            }
+            Self::FlatRounded { half_flat, radius } => crate::analytical::FlatRounded {
+                half_flat,
+                radius,
+                compliance,
+            }
+            .half_width(load),
+            Self::PowerLaw {
+                coefficient,
+                exponent,
+            } => crate::analytical::power_law_half_width(coefficient, exponent, load, compliance),
+        }
     }
 }
 
@@ -135,6 +206,30 @@ mod tests {
         let (x1, x2) = (-1e-5, 3e-5);
         let simpson = (x2 - x1) / 6.0 * (p.gap(x1) + 4.0 * p.gap(0.5 * (x1 + x2)) + p.gap(x2));
         assert!((p.gap_integral(x1, x2) - simpson).abs() <= 1e-15 * simpson);
+    }
+
+    /// The power law: h' is the derivative of h, ∫h that of a fine midpoint rule, and n = 2
+    /// with A = 1/(2R) is the cylinder (its frictionless half-width Hertz's).
+    #[test]
+    fn the_power_law_slope_and_integral_are_those_of_its_gap() {
+        let p = Profile::power_law(1.25e11, 4.0);
+        for x in [-3e-5_f64, 1e-6, 2e-5] {
+            let step = 1e-10;
+            let slope = (p.gap(x + step) - p.gap(x - step)) / (2.0 * step);
+            assert!((slope - p.slope(x)).abs() <= 1e-6 * p.slope(x).abs());
+        }
+        let (x1, x2) = (-3e-5, 2e-5);
+        let n = 200_000;
+        let h = (x2 - x1) / n as f64;
+        let midpoint: f64 = (0..n).map(|i| p.gap(x1 + (i as f64 + 0.5) * h) * h).sum();
+        assert!((p.gap_integral(x1, x2) - midpoint).abs() <= 1e-8 * midpoint);
+        let (parabola, cylinder) = (Profile::power_law(1.0 / 0.12, 2.0), Profile::cylinder(0.06));
+        for x in [-3e-5, 2e-5] {
+            assert!((parabola.gap(x) - cylinder.gap(x)).abs() <= 1e-15 * cylinder.gap(x));
+        }
+        let (load, compliance) = (2000.0, 2.3e-11);
+        let hertz = cylinder.frictionless_half_width(load, compliance);
+        assert!((parabola.frictionless_half_width(load, compliance) / hertz - 1.0).abs() < 1e-13);
     }
 
     /// The flat punch with rounded corners: zero on the flat, the corner parabola beyond it,

@@ -25,8 +25,8 @@
 //! the step (Spence's aluminium case, Goodman's approximation: b/a 2.6e−3 below the closed form
 //! at 2 % steps and 1.4e−3 at 1 %; test
 //! `contact::general::tests::spence_stick_ratio_goodman_and_full_coupling`). Two passes: the
-//! first, with steps of [`COARSE_RATIO`] on a mesh graded towards Hertz's ends
-//! ([`Solver::hertz_half_width`]), finds the contact and its zone ends; the second, with
+//! first, with steps of [`COARSE_RATIO`] on a mesh graded towards the frictionless contact
+//! ends ([`Solver::first_half_width`]), finds the contact and its zone ends; the second, with
 //! steps of [`RATIO`], on a mesh graded as a handover's is (elements of
 //! [`END_SIZE`]·a at the contact ends, [`STICK_SIZE`]·a at every zone end, band `±1.25a`),
 //! gives the state. The mesh is symmetric about the punch axis, as the loading is.
@@ -166,12 +166,12 @@ pub fn load_by_steps(
     let mut half = 1.6;
     let first = loop {
         let probe = Solver::new(model, Mesh::uniform(-1.0, 1.0, 2), Options::default());
-        let a = model.profile.flat_half_width() + probe.hertz_half_width(full);
+        let a = probe.first_half_width(full);
         if !(a.is_normal() && (half * a).is_normal() && (END_SIZE * a).is_normal()) {
             return Err(SolveFailure::NoAdmissibleState {
                 reason: format!(
-                    "the contact half-width of P = {normal_load:e} N/m ({a:e} m by Hertz) is out \
-                     of the range of floating-point numbers"
+                    "the contact half-width of P = {normal_load:e} N/m ({a:e} m, frictionless) is \
+                     out of the range of floating-point numbers"
                 ),
             });
         }

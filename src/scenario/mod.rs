@@ -212,9 +212,25 @@ fn build(
     history: Option<crate::history::LoadHistory>,
     time_tolerance: f64,
 ) -> Result<Scenario, Vec<Issue>> {
-    let profile = match raw.punch.flat_half_width {
-        Some(b) if b > 0.0 => Profile::flat_rounded(b, raw.punch.radius),
-        _ => Profile::cylinder(raw.punch.radius),
+    let profile = match (&raw.punch.profile, raw.punch.radius) {
+        (
+            Some(RawProfile::FlatRounded {
+                flat_half_width,
+                radius,
+            }),
+            _,
+        ) if *flat_half_width > 0.0 => Profile::flat_rounded(*flat_half_width, *radius),
+        (Some(RawProfile::Cylinder { radius } | RawProfile::FlatRounded { radius, .. }), _) => {
+            Profile::cylinder(*radius)
+        }
+        (
+            Some(RawProfile::PowerLaw {
+                coefficient,
+                exponent,
+            }),
+            _,
+        ) => Profile::power_law(*coefficient, *exponent),
+        (None, radius) => Profile::cylinder(radius.expect("validated: a radius or a profile")),
     };
     let model = ContactModel::try_new(material, profile, raw.friction, electrode)
         .map_err(|failure| vec![material_issue(&raw.material, &failure)])?

@@ -207,15 +207,42 @@ pub enum RawMaterial {
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawPunch {
-    /// Radius R (m), > 0: of the cylinder, or of the corners of a flat punch.
-    pub radius: f64,
-    /// Half-width b (m) of a flat face with corners of radius R (the fretting-fatigue pad);
-    /// absent or 0 for the cylinder.
+    /// Radius R (m), > 0, of a cylinder: the shorthand for `profile` `{"kind": "cylinder"}`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub flat_half_width: Option<f64>,
+    pub radius: Option<f64>,
+    /// The punch's profile (instead of `radius`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile: Option<RawProfile>,
     /// Electric boundary condition (default: none, for an elastic half-plane).
     #[serde(default)]
     pub electrode: RawElectrode,
+}
+
+/// A punch profile, `h(x)` the height of its surface above its lowest point
+/// ([`crate::contact::Profile`]).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum RawProfile {
+    /// A cylinder of radius R (m): `h = x²/(2R)`.
+    Cylinder {
+        /// R (m), > 0.
+        radius: f64,
+    },
+    /// A flat face of half-width b (m) with corners of radius R (m), the fretting-fatigue pad:
+    /// `h = (|x| − b)²/(2R)` beyond the flat.
+    FlatRounded {
+        /// b (m), ≥ 0 (0 is the cylinder).
+        flat_half_width: f64,
+        /// R (m), > 0.
+        radius: f64,
+    },
+    /// A power law `h = A|x|ⁿ`.
+    PowerLaw {
+        /// A (m^(1−n)), > 0.
+        coefficient: f64,
+        /// n, ≥ 1 (a convex profile).
+        exponent: f64,
+    },
 }
 
 /// Electrode model.

@@ -114,22 +114,69 @@ pub(super) fn surface_response(
     }
 }
 
-/// Punch radius, loads, datum distance and friction.
-pub(super) fn validate_loads(issues: &mut Vec<Issue>, raw: &RawScenario) {
-    positive(issues, "punch.radius", raw.punch.radius, "m");
-    if let Some(b) = raw.punch.flat_half_width {
-        if !(b.is_finite() && b >= 0.0) {
-            issues.push(Issue::new(
-                "punch.flat_half_width",
-                format!("{b} m is invalid; it must be finite and ≥ 0"),
-            ));
-        } else if b > 0.0 && raw.numerics.solver == crate::history::SolverChoice::Spectral {
-            issues.push(Issue::new(
-                "numerics.solver",
-                "\"spectral\" is invalid with a flat punch (`punch.flat_half_width` > 0); it must be \"auto\" or \"general\" (the spectral solver takes a cylinder only)",
-            ));
+/// The punch's shape: `radius` (a cylinder) or `profile`, one of them, with its rules; a
+/// profile that is not a cylinder is for the general solver only.
+fn validate_profile(issues: &mut Vec<Issue>, raw: &RawScenario) {
+    let punch = &raw.punch;
+    match (punch.radius, &punch.profile) {
+        (Some(r), None) => positive(issues, "punch.radius", r, "m"),
+        (None, None) => issues.push(Issue::new(
+            "punch",
+            "an object without `radius` or `profile` is invalid; it must give one of them (a cylinder's `radius`, or a `profile`)",
+        )),
+        (Some(_), Some(_)) => issues.push(Issue::new(
+            "punch.profile",
+            "a profile beside `punch.radius` is invalid; it must be one or the other",
+        )),
+        (None, Some(profile)) => {
+            let at = |field: &str| format!("punch.profile.{field}");
+            let cylinder = match *profile {
+                RawProfile::Cylinder { radius } => {
+                    positive(issues, &at("radius"), radius, "m");
+                    true
+                }
+                RawProfile::FlatRounded {
+                    flat_half_width,
+                    radius,
+                } => {
+                    positive(issues, &at("radius"), radius, "m");
+                    if !(flat_half_width.is_finite() && flat_half_width >= 0.0) {
+                        issues.push(Issue::new(
+                            at("flat_half_width"),
+                            format!("{flat_half_width} m is invalid; it must be finite and ≥ 0"),
+                        ));
+                    }
+                    flat_half_width == 0.0
+                }
+                RawProfile::PowerLaw {
+                    coefficient,
+                    exponent,
+                } => {
+                    positive(issues, &at("coefficient"), coefficient, "m^(1−n)");
+                    if !(exponent.is_finite() && (1.0..=20.0).contains(&exponent)) {
+                        issues.push(Issue::new(
+                            at("exponent"),
+                            format!(
+                                "{exponent} is invalid; it must lie in [1, 20] (below 1 the profile is not convex and has a cusp at its tip)"
+                            ),
+                        ));
+                    }
+                    false
+                }
+            };
+            if !cylinder && raw.numerics.solver == crate::history::SolverChoice::Spectral {
+                issues.push(Issue::new(
+                    "numerics.solver",
+                    "\"spectral\" is invalid with a punch that is not a cylinder; it must be \"auto\" or \"general\" (the spectral solver takes a cylinder only)",
+                ));
+            }
         }
     }
+}
+
+/// Punch radius, loads, datum distance and friction.
+pub(super) fn validate_loads(issues: &mut Vec<Issue>, raw: &RawScenario) {
+    validate_profile(issues, raw);
     positive(issues, "normal_load", raw.normal_load, "N/m");
     positive(issues, "reference_distance", raw.reference_distance, "m");
     if !(raw.friction.is_finite() && raw.friction >= 0.0) {

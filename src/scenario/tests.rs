@@ -104,37 +104,75 @@ fn every_problem_is_collected() {
     );
 }
 
-/// A flat punch: its half-width must be finite and ≥ 0, and the spectral solver alone cannot
-/// take it; 0 is the cylinder.
+/// The punch's shape: a `radius` or a `profile`, one of them; each profile's rules; the
+/// spectral solver alone takes a cylinder only; a flat punch of half-width 0 is the cylinder.
 #[test]
-fn flat_punch_rules() {
-    let flat = |b: &str, solver: &str| {
-        DEFAULT_SCENARIO
-            .replace(
-                "\"radius\": 0.06",
-                &format!("\"radius\": 0.06, \"flat_half_width\": {b}"),
-            )
-            .replace(
-                "\"friction\": 0.3",
-                &format!("\"friction\": 0.3, \"numerics\": {{\"solver\": \"{solver}\"}}"),
-            )
+fn punch_profile_rules() {
+    let with = |punch: &str, solver: &str| {
+        DEFAULT_SCENARIO.replace("\"radius\": 0.06", punch).replace(
+            "\"friction\": 0.3",
+            &format!("\"friction\": 0.3, \"numerics\": {{\"solver\": \"{solver}\"}}"),
+        )
     };
     let messages =
         |text: &str| -> Vec<String> { issues(text).iter().map(|i| i.to_string()).collect() };
+    let flat = |b: &str| {
+        format!(
+            "\"profile\": {{\"kind\": \"flat_rounded\", \"flat_half_width\": {b}, \"radius\": 0.06}}"
+        )
+    };
+    let power = |n: &str| {
+        format!(
+            "\"profile\": {{\"kind\": \"power_law\", \"coefficient\": 10.0, \"exponent\": {n}}}"
+        )
+    };
     assert_eq!(
-        messages(&flat("-0.001", "auto")),
-        ["`punch.flat_half_width` = -0.001 m is invalid; it must be finite and ≥ 0"]
+        messages(&with(&flat("-0.001"), "auto")),
+        ["`punch.profile.flat_half_width` = -0.001 m is invalid; it must be finite and ≥ 0"]
     );
     assert_eq!(
-        messages(&flat("1e-5", "spectral")),
+        messages(&with(&power("0.5"), "auto")),
         [
-            "`numerics.solver` = \"spectral\" is invalid with a flat punch (`punch.flat_half_width` > 0); it must be \"auto\" or \"general\" (the spectral solver takes a cylinder only)"
+            "`punch.profile.exponent` = 0.5 is invalid; it must lie in [1, 20] (below 1 the profile is not convex and has a cusp at its tip)"
         ]
     );
-    let sc = validate(parse(&flat("1e-5", "auto"), Path::new("t")).unwrap()).unwrap();
-    assert_eq!(sc.model.profile, Profile::flat_rounded(1e-5, 0.06));
-    let sc = validate(parse(&flat("0", "spectral"), Path::new("t")).unwrap()).unwrap();
-    assert!(sc.model.profile.is_cylinder());
+    assert_eq!(
+        messages(&with(&flat("1e-5"), "spectral")),
+        [
+            "`numerics.solver` = \"spectral\" is invalid with a punch that is not a cylinder; it must be \"auto\" or \"general\" (the spectral solver takes a cylinder only)"
+        ]
+    );
+    assert_eq!(
+        messages(&with(&format!("\"radius\": 0.06, {}", power("4")), "auto")),
+        [
+            "`punch.profile` = a profile beside `punch.radius` is invalid; it must be one or the other"
+        ]
+    );
+    assert_eq!(
+        messages(&with("\"kind\": \"x\"", "auto").replace("\"kind\": \"x\", ", "")),
+        [
+            "`punch` = an object without `radius` or `profile` is invalid; it must give one of them (a cylinder's `radius`, or a `profile`)"
+        ]
+    );
+    let model = |text: &str| {
+        validate(parse(text, Path::new("t")).unwrap())
+            .unwrap()
+            .model
+    };
+    assert_eq!(
+        model(&with(&flat("1e-5"), "auto")).profile,
+        Profile::flat_rounded(1e-5, 0.06)
+    );
+    assert!(model(&with(&flat("0"), "spectral")).profile.is_cylinder());
+    assert_eq!(
+        model(&with(&power("4"), "general")).profile,
+        Profile::power_law(10.0, 4.0)
+    );
+    let cylinder = "\"profile\": {\"kind\": \"cylinder\", \"radius\": 0.06}";
+    assert_eq!(
+        model(&with(cylinder, "spectral")).profile,
+        Profile::cylinder(0.06)
+    );
 }
 
 #[test]

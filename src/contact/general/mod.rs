@@ -398,16 +398,17 @@ impl Solver {
         c.coupled && c.friction > 0.0 && (c.w12 != 0.0 || w13 != 0.0)
     }
 
-    /// Hertz's half-width `√(2P Y*/(π κ))` for the loads, with the pressure compliance
-    /// `Y* = y22` (no charge on the contact) or `y22 − y23²/y33` (a conducting punch) and the
-    /// profile's curvature κ: a first guess of the contact (m).
-    pub fn hertz_half_width(&self, loads: Loads) -> f64 {
+    /// The frictionless half-width of the profile under the loads' P
+    /// ([`crate::contact::Profile::frictionless_half_width`]: Hertz's for the cylinder), with
+    /// the pressure compliance `Y* = y22` (no charge on the contact) or `y22 − y23²/y33` (a
+    /// conducting punch): a first guess of the contact (m).
+    pub fn first_half_width(&self, loads: Loads) -> f64 {
         let c = &self.coefficients;
         let ystar = match (self.electric_control(loads), c.electric) {
             (ElectricControl::None, _) | (_, None) => c.y22,
             (_, Some((y23, y33, _))) => c.y22 - y23 * y23 / y33,
         };
-        (2.0 * loads.normal * ystar / (c.profile.curvature() * PI)).sqrt()
+        c.profile.frictionless_half_width(loads.normal, ystar)
     }
 
     /// The mean gap between the punch and the surface over each element of a state,
@@ -435,12 +436,12 @@ impl Solver {
         )
     }
 
-    /// The contact elements of the start of a step: the previous contact, or Hertz's width
-    /// with the pressure compliance of the electrode if there was none.
+    /// The contact elements of the start of a step: the previous contact, or the frictionless
+    /// width with the pressure compliance of the electrode if there was none.
     fn initial_contact(&self, previous: &GeneralState, loads: Loads) -> Vec<bool> {
         let mut contact: Vec<bool> = previous.pressure.iter().map(|&p| p > 0.0).collect();
         if !contact.iter().any(|&c| c) {
-            let a = self.hertz_half_width(loads);
+            let a = self.first_half_width(loads);
             for (i, flag) in contact.iter_mut().enumerate() {
                 let (x1, x2) = (self.mesh.edges[i], self.mesh.edges[i + 1]);
                 *flag = x2.abs().min(x1.abs()) < a || (x1 <= 0.0 && x2 >= 0.0);

@@ -830,3 +830,53 @@ fn flat_punch_with_rounded_corners_ciavarella_half_width_centre_pressure_and_sti
         assert!((s2 - c).abs() <= width_at(&mesh, c) && (s1 + c).abs() <= width_at(&mesh, -c));
     }
 }
+
+/// The power-law punch `h = A|x|⁴` on the uncoupled half-plane (ν = 0.5), P = 2240 N/m:
+/// the contact half-width against `P = 2nA aⁿ W(n)/Y*` (W(4) = 3π/16, Wallis), and after
+/// Q = 0.5 ηP (η = 0.3) the stick zone of the same punch's pressure difference (Jäger and
+/// Ciavarella's superposition), `c/a = (1 − Q/(ηP))^(1/n)`, each within one element.
+#[test]
+fn power_law_punch_half_width_and_stick_zone() {
+    use crate::analytical::{power_law_half_width, wallis};
+    assert!((wallis(4.0) - 3.0 * std::f64::consts::PI / 16.0).abs() < 1e-14);
+    assert!((wallis(1.0) - 1.0).abs() < 1e-14 && (wallis(3.0) - 2.0 / 3.0).abs() < 1e-14);
+    let (coefficient, exponent, p, eta) = (1.25e11, 4.0, 2240.0, 0.3);
+    let constants = IsotropicConstants {
+        shear_modulus: ALUMINIUM.shear_modulus,
+        poisson_ratio: 0.5,
+    };
+    let model = ContactModel::new(
+        Material::Elastic(constants),
+        Profile::power_law(coefficient, exponent),
+        eta,
+        Electrode::None,
+    );
+    let a = power_law_half_width(coefficient, exponent, p, model.compliance.y22);
+    let c = a * 0.5f64.powf(1.0 / exponent);
+    let focus = [
+        Focus { at: a, size: 1e-3 * a },
+        Focus { at: c, size: 1e-3 * a },
+    ];
+    let mesh = Mesh::symmetric(1.1 * a, &focus, 1.05, 0.01 * a);
+    let solver = Solver::new(&model, mesh.clone(), Options::default());
+    let (pressed, _) = solver
+        .step(&GeneralState::unloaded(mesh.clone()), loads(p, 0.0))
+        .unwrap();
+    let (lo, hi) = pressed.contact_extent().unwrap();
+    let (sheared, _) = solver.step(&pressed, loads(p, 0.5 * eta * p)).unwrap();
+    let stick: Vec<_> = sheared
+        .zones()
+        .into_iter()
+        .filter(|z| z.0 == ElementState::Stick)
+        .collect();
+    eprintln!(
+        "power law n = 4: a {:.6e} m (exact {a:.6e}), stick {:?} (exact c = {c:.6e} m)",
+        0.5 * (hi - lo),
+        stick.iter().map(|z| (z.1, z.2)).collect::<Vec<_>>()
+    );
+    // Measured: Δa = −2.4e−4 a (end elements 1e−3 a), Δc = +6.2e−4 a (1e−3 a at c).
+    assert!((hi - a).abs() <= width_at(&mesh, a) && (lo + a).abs() <= width_at(&mesh, -a));
+    assert_eq!(stick.len(), 1);
+    assert!((stick[0].2 - c).abs() <= width_at(&mesh, c));
+    assert!((stick[0].1 + c).abs() <= width_at(&mesh, -c));
+}
