@@ -763,6 +763,30 @@ fn normal_load_lowered_at_constant_q_follows_cattaneo_mindlin_of_the_current_loa
     assert!(l1 < 1e-4, "{l1:e}");
 }
 
+/// Aluminium's shear modulus with ν = 0.5 (uncoupled: Dundurs' β = 0) under `profile`.
+fn uncoupled(profile: Profile, friction: f64) -> ContactModel {
+    let constants = IsotropicConstants {
+        shear_modulus: ALUMINIUM.shear_modulus,
+        poisson_ratio: 0.5,
+    };
+    ContactModel::new(Material::Elastic(constants), profile, friction, Electrode::None)
+}
+
+/// P in one step from the unloaded state, then Q: the pressed state and the stick zones
+/// `(lo, hi)` of the sheared one.
+fn press_then_shear(solver: &Solver, p: f64, q: f64) -> (GeneralState, Vec<(f64, f64)>) {
+    let unloaded = GeneralState::unloaded(solver.mesh().clone());
+    let (pressed, _) = solver.step(&unloaded, loads(p, 0.0)).unwrap();
+    let (sheared, _) = solver.step(&pressed, loads(p, q)).unwrap();
+    let stick = sheared
+        .zones()
+        .into_iter()
+        .filter(|z| z.0 == ElementState::Stick)
+        .map(|z| (z.1, z.2))
+        .collect();
+    (pressed, stick)
+}
+
 /// The flat punch with rounded corners (Ciavarella, Hills and Monno 1998;
 /// [`crate::analytical::FlatRounded`]) on the uncoupled half-plane (ν = 0.5), flat half-width
 /// b = 1e−5 m, corner radius 10 mm, P = 2240 N/m: the contact half-width and the pressure at
@@ -772,16 +796,7 @@ fn normal_load_lowered_at_constant_q_follows_cattaneo_mindlin_of_the_current_loa
 fn flat_punch_with_rounded_corners_ciavarella_half_width_centre_pressure_and_stick_zone() {
     use crate::analytical::FlatRounded;
     let (b, radius, p, eta) = (1e-5, 10e-3, 2240.0, 0.3);
-    let constants = IsotropicConstants {
-        shear_modulus: ALUMINIUM.shear_modulus,
-        poisson_ratio: 0.5,
-    };
-    let model = ContactModel::new(
-        Material::Elastic(constants),
-        Profile::flat_rounded(b, radius),
-        eta,
-        Electrode::None,
-    );
+    let model = uncoupled(Profile::flat_rounded(b, radius), eta);
     let exact = FlatRounded {
         half_flat: b,
         radius,
@@ -799,25 +814,16 @@ fn flat_punch_with_rounded_corners_ciavarella_half_width_centre_pressure_and_sti
         ];
         let mesh = Mesh::symmetric(1.1 * a, &focus, 1.05, 0.01 * a);
         let solver = Solver::new(&model, mesh.clone(), Options::default());
-        let (pressed, _) = solver
-            .step(&GeneralState::unloaded(mesh.clone()), loads(p, 0.0))
-            .unwrap();
+        let (pressed, stick) = press_then_shear(&solver, p, q);
         let (lo, hi) = pressed.contact_extent().unwrap();
         let centre = (0..mesh.len())
             .find(|&i| mesh.edges[i] <= 0.0 && 0.0 < mesh.edges[i + 1])
             .unwrap();
         let p0 = exact.centre_pressure(a);
-        let (sheared, _) = solver.step(&pressed, loads(p, q)).unwrap();
-        let stick: Vec<_> = sheared
-            .zones()
-            .into_iter()
-            .filter(|z| z.0 == ElementState::Stick)
-            .collect();
         eprintln!(
-            "flat punch, elements {size:e} a: a {:.6e} m (exact {a:.6e}), p(0) {:.6e} Pa (exact {p0:.6e}), stick {:?} (exact c = {c:.6e} m, c/a = {:.5})",
+            "flat punch, elements {size:e} a: a {:.6e} m (exact {a:.6e}), p(0) {:.6e} Pa (exact {p0:.6e}), stick {stick:?} (exact c = {c:.6e} m, c/a = {:.5})",
             0.5 * (hi - lo),
             pressed.pressure[centre],
-            stick.iter().map(|z| (z.1, z.2)).collect::<Vec<_>>(),
             c / a
         );
         // Measured: Δa = −3.3e−4 a and +3.0e−4 a (end elements 2e−3 a and 1e−3 a), p(0) within
@@ -826,7 +832,7 @@ fn flat_punch_with_rounded_corners_ciavarella_half_width_centre_pressure_and_sti
         assert!((hi - a).abs() <= width_at(&mesh, a) && (lo + a).abs() <= width_at(&mesh, -a));
         assert!((pressed.pressure[centre] / p0 - 1.0).abs() < 1e-4);
         assert_eq!(stick.len(), 1);
-        let (s1, s2) = (stick[0].1, stick[0].2);
+        let (s1, s2) = stick[0];
         assert!((s2 - c).abs() <= width_at(&mesh, c) && (s1 + c).abs() <= width_at(&mesh, -c));
     }
 }
@@ -841,16 +847,7 @@ fn power_law_punch_half_width_and_stick_zone() {
     assert!((wallis(4.0) - 3.0 * std::f64::consts::PI / 16.0).abs() < 1e-14);
     assert!((wallis(1.0) - 1.0).abs() < 1e-14 && (wallis(3.0) - 2.0 / 3.0).abs() < 1e-14);
     let (coefficient, exponent, p, eta) = (1.25e11, 4.0, 2240.0, 0.3);
-    let constants = IsotropicConstants {
-        shear_modulus: ALUMINIUM.shear_modulus,
-        poisson_ratio: 0.5,
-    };
-    let model = ContactModel::new(
-        Material::Elastic(constants),
-        Profile::power_law(coefficient, exponent),
-        eta,
-        Electrode::None,
-    );
+    let model = uncoupled(Profile::power_law(coefficient, exponent), eta);
     let a = power_law_half_width(coefficient, exponent, p, model.compliance.y22);
     let c = a * 0.5f64.powf(1.0 / exponent);
     let focus = [
@@ -859,24 +856,15 @@ fn power_law_punch_half_width_and_stick_zone() {
     ];
     let mesh = Mesh::symmetric(1.1 * a, &focus, 1.05, 0.01 * a);
     let solver = Solver::new(&model, mesh.clone(), Options::default());
-    let (pressed, _) = solver
-        .step(&GeneralState::unloaded(mesh.clone()), loads(p, 0.0))
-        .unwrap();
+    let (pressed, stick) = press_then_shear(&solver, p, 0.5 * eta * p);
     let (lo, hi) = pressed.contact_extent().unwrap();
-    let (sheared, _) = solver.step(&pressed, loads(p, 0.5 * eta * p)).unwrap();
-    let stick: Vec<_> = sheared
-        .zones()
-        .into_iter()
-        .filter(|z| z.0 == ElementState::Stick)
-        .collect();
     eprintln!(
-        "power law n = 4: a {:.6e} m (exact {a:.6e}), stick {:?} (exact c = {c:.6e} m)",
+        "power law n = 4: a {:.6e} m (exact {a:.6e}), stick {stick:?} (exact c = {c:.6e} m)",
         0.5 * (hi - lo),
-        stick.iter().map(|z| (z.1, z.2)).collect::<Vec<_>>()
     );
     // Measured: Δa = −2.4e−4 a (end elements 1e−3 a), Δc = +6.2e−4 a (1e−3 a at c).
     assert!((hi - a).abs() <= width_at(&mesh, a) && (lo + a).abs() <= width_at(&mesh, -a));
     assert_eq!(stick.len(), 1);
-    assert!((stick[0].2 - c).abs() <= width_at(&mesh, c));
-    assert!((stick[0].1 + c).abs() <= width_at(&mesh, -c));
+    assert!((stick[0].1 - c).abs() <= width_at(&mesh, c));
+    assert!((stick[0].0 + c).abs() <= width_at(&mesh, -c));
 }
