@@ -163,10 +163,10 @@ pub fn load_by_steps(
 ) -> Result<(GeneralRun, Loading), SolveFailure> {
     let full = loads_of(model, normal_load, 0.0);
     // First pass: the contact and its zones, on a band widened until it holds the contact.
+    let probe = Solver::new(model, Mesh::uniform(-1.0, 1.0, 2), Options::default());
+    let a = probe.first_half_width(full);
     let mut half = 1.6;
     let first = loop {
-        let probe = Solver::new(model, Mesh::uniform(-1.0, 1.0, 2), Options::default());
-        let a = probe.first_half_width(full);
         if !(a.is_normal() && (half * a).is_normal() && (END_SIZE * a).is_normal()) {
             return Err(SolveFailure::NoAdmissibleState {
                 reason: format!(
@@ -184,8 +184,16 @@ pub fn load_by_steps(
         let (state, _) = steps(&solver, full, COARSE_RATIO)?;
         let (lo, _) = state.contact_extent().expect("a loaded contact");
         let edge = state.mesh.edges[1] - state.mesh.edges[0];
-        if lo - state.mesh.edges[0] > 2.0 * edge || half > 6.0 {
+        if lo - state.mesh.edges[0] > 2.0 * edge {
             break state;
+        }
+        if half > 6.0 {
+            return Err(SolveFailure::NoAdmissibleState {
+                reason: format!(
+                    "the contact reaches the edge of a band of {half} times its frictionless \
+                     half-width {a:e} m"
+                ),
+            });
         }
         half *= 2.0;
     };

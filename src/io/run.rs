@@ -474,11 +474,12 @@ pub(crate) fn solve_from<'a>(
             .map(|x| state.surface_point(model, x))
             .collect()
     };
+    let loaded = normal.solved_state();
     let mut fields = vec![FieldSet {
         stem: "normal_loading".into(),
         label: "end of normal loading".into(),
-        points: sample(&normal.solved_state()),
-        ends: zone_ends(&normal.solved_state(), &normal.record(0.0)),
+        points: sample(&loaded),
+        ends: zone_ends(&loaded, &normal.record(0.0)),
     }];
     let (at_snapshots, snapshot_rows) =
         snapshot_fields(scenario, &kept.at_times, &sample, tally.last(), &mut warnings);
