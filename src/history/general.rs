@@ -254,7 +254,9 @@ pub struct GeneralRun {
     /// phase of the handover): 2, then doubled after each try that fails, so that a phase the
     /// spectral solver cannot represent costs a few of its attempts, not one a step. Not 1:
     /// after the handover's own step the try would be the step the spectral solver just failed
-    /// (or that the general solver's check contradicted), from the same state.
+    /// (or that the general solver's check contradicted), from the same state. A run handed
+    /// over at the first step after a take-back ([`GeneralRun::take_back_lost`]) starts at
+    /// [`GeneralRun::LOST_TAKE_BACK_WAIT`].
     resume_at: usize,
 }
 
@@ -383,6 +385,21 @@ impl GeneralRun {
     /// A try to take the state back failed: the next one after twice as many steps.
     pub fn resume_failed(&mut self) {
         self.resume_at = 2 * self.steps.max(1);
+    }
+
+    /// General steps before the first try to take the state back in a run handed over at the
+    /// first step after a take-back ([`GeneralRun::take_back_lost`]), in place of 2.
+    pub const LOST_TAKE_BACK_WAIT: usize = 4;
+
+    /// The run was handed over at the first step after the spectral solver took the state
+    /// back: that take-back did not hold, and one at the next try would most likely not hold
+    /// either (the general solver's state passes for a spectral one at some steps of the phase
+    /// and not at the next, e.g. an end layer of reversed slip about one element thick that
+    /// comes and goes), each time at the cost of a failed spectral step. The next try is due
+    /// after [`GeneralRun::LOST_TAKE_BACK_WAIT`] steps instead of 2 (then doubled as after any
+    /// failed try), and at the end of the phase as always.
+    pub fn take_back_lost(&mut self) {
+        self.resume_at = self.resume_at.max(Self::LOST_TAKE_BACK_WAIT);
     }
 
     /// The solver.

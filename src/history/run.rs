@@ -9,7 +9,7 @@ use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
 
 use super::driver::{DriverState, SolvedStep, Tried, finish_step, hold_record, try_step};
-use super::general::{GeneralRun, RunOptions, SolverChoice, ZoneCount};
+use super::general::{GeneralRun, RunOptions, SolverChoice, SolverKind, ZoneCount};
 use super::increments::{IncrementInputs, StepIncrements};
 use super::load::{LoadHistory, LoadPoint};
 use super::normal::NormalEnd;
@@ -350,6 +350,12 @@ fn spectral_stretch(
                 keep(records, record, options.keep_records);
             }
         };
+        // The stretch begins right after a take-back (`resumes`: the last record is the
+        // general solver's): a handover at its first step is a take-back lost.
+        let after_take_back = options.solver == SolverChoice::Auto
+            && records
+                .last()
+                .is_some_and(|r| r.solver == SolverKind::General);
         let mut pending: Option<Box<SolvedStep>> = None;
         for (k, &point) in points.iter().enumerate() {
             // The first step of a phase is checked by the general solver from the state before
@@ -361,7 +367,7 @@ fn spectral_stretch(
             let tried = try_step(model, disc, driver, point, options.slip);
             finish(pending.take(), driver, records, observer);
             if let (true, Ok(Tried::Slip(trial))) = (check, &tried)
-                && let Some((failure, taken)) = contradicted(
+                && let Some((failure, mut taken)) = contradicted(
                     model,
                     driver,
                     (point, options),
@@ -369,6 +375,9 @@ fn spectral_stretch(
                     recall,
                 )
             {
+                if k == 0 && after_take_back {
+                    taken.0.take_back_lost();
+                }
                 return Some(Stop {
                     at: k,
                     failure,
@@ -389,10 +398,13 @@ fn spectral_stretch(
                     pending = Some(solved);
                 }
                 Err(failure) => {
+                    let taken = (k == 0 && after_take_back)
+                        .then(|| take_back_lost(model, driver, (point, options), recall))
+                        .flatten();
                     return Some(Stop {
                         at: k,
                         failure,
-                        taken: None,
+                        taken,
                     });
                 }
             }
@@ -408,6 +420,22 @@ fn spectral_stretch(
         finish(pending.take(), driver, records, observer);
         None
     })
+}
+
+/// The general solver's run and record of the step at `point`, which the spectral solver
+/// failed right after it took the state back (`resumes`), handed over from the driver's state
+/// with its next try postponed ([`GeneralRun::take_back_lost`]); `None` when the general solver
+/// cannot take the step either (the caller's handover then meets that failure).
+fn take_back_lost(
+    model: &ContactModel,
+    driver: &DriverState,
+    (point, options): (LoadPoint, RunOptions),
+    recall: &mut Recall,
+) -> Option<(GeneralRun, StepRecord)> {
+    let mut run = GeneralRun::handover(model, driver, options.general_element_size, recall);
+    let record = run.step(model, point, recall).ok()?;
+    run.take_back_lost();
+    Some((run, record))
 }
 
 /// Whether the general solver's record of a step and the spectral solver's describe one state

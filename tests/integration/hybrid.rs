@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use fretsim::history::{NoObserver, SolverKind, StepRecord};
+use fretsim::history::{GeneralRun, NoObserver, SolverKind, StepRecord};
 
 /// A scenario from JSON text.
 fn scenario(text: &str) -> fretsim::Scenario {
@@ -197,4 +197,41 @@ fn contact_translates_alike_in_both_solvers_below_gamma1() {
         .filter(|r| r.solver == SolverKind::General)
         .count();
     assert!(taken <= 8, "{taken} general steps under auto");
+}
+
+/// A take-back that does not hold: in the Figure-3 history at η = 0.1 the spectral solver
+/// takes the state back at step 24 and fails step 25 (the receding end's layer of reversed
+/// slip comes back). A run handed over at the first step after a take-back tries the next one
+/// after [`GeneralRun::LOST_TAKE_BACK_WAIT`] general steps, not after 2 (before: taken back at
+/// step 26, the spectral solver from step 27; now at step 28, from step 29), so that where the
+/// general solver's state passes for a spectral one only at every other step the spectral
+/// solver fails a step at most every `LOST_TAKE_BACK_WAIT` steps, not every second one.
+#[test]
+fn a_lost_take_back_postpones_the_next_try() {
+    let auto = fretsim::solve(&scenario(&figure3_at_eta_0_1("auto")), &mut NoObserver).unwrap();
+    assert!(auto.failure.is_none(), "{:?}", auto.failure);
+    let r = &auto.records;
+    let lost: Vec<usize> = auto
+        .summary
+        .solver
+        .handovers
+        .iter()
+        .map(|h| h.step)
+        .filter(|&h| h >= 2 && r[h - 1].solver == SolverKind::General)
+        .collect();
+    assert_eq!(lost, [25], "the take-back at step 24 is lost at step 25");
+    for &h in &lost {
+        let held = &r[h..(h + GeneralRun::LOST_TAKE_BACK_WAIT).min(r.len())];
+        assert!(
+            held.iter().all(|s| s.solver == SolverKind::General),
+            "step {h}: the next take-back before {} general steps",
+            GeneralRun::LOST_TAKE_BACK_WAIT
+        );
+    }
+    let wait = GeneralRun::LOST_TAKE_BACK_WAIT;
+    assert_eq!(
+        r[25 + wait].solver,
+        SolverKind::Spectral,
+        "taken back again"
+    );
 }
