@@ -70,6 +70,7 @@ fn step(
         step: n,
         t: n as f64,
         q: f * sc.model.friction * sc.normal_load,
+        punch: None,
     };
     advance(
         &sc.model,
@@ -119,6 +120,7 @@ fn bench_state(
             step: n,
             t: n as f64,
             q: next * sc.model.friction * sc.normal_load,
+            punch: None,
         };
         g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
             b.iter(|| {
@@ -181,6 +183,7 @@ fn steps_in_a_run(c: &mut Criterion) {
             step: loads.len() + k + 1,
             t: (loads.len() + k + 1) as f64,
             q: f * sc.model.friction * sc.normal_load,
+            punch: None,
         })
         .collect();
     for (name, pipelined) in [
@@ -278,6 +281,7 @@ fn cycle(c: &mut Criterion) {
                 (3.0, -0.5 * lim),
                 (5.0, 0.5 * lim),
             ],
+            punch: None,
             steps_per_segment: 10,
             max_step: 0.05 * lim,
         };

@@ -109,10 +109,9 @@ struct Outcome {
 }
 
 fn outcome(scenario: &Scenario, solution: &fretsim::io::Solution) -> Outcome {
-    let limit = scenario.model.friction * scenario.normal_load;
     Outcome {
         summary: serde_json::to_string(&solution.summary).expect("a summary serialises"),
-        steps: steps_table(&solution.records, limit),
+        steps: steps_table(&solution.records, scenario.model.friction),
         cycles: cycles_table(&solution.cycles),
         fields: solution
             .fields

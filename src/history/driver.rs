@@ -279,7 +279,7 @@ pub fn try_step(
     point: LoadPoint,
     options: SlipOptions,
 ) -> Result<Tried, StepFailure> {
-    let LoadPoint { step, t, q } = point;
+    let LoadPoint { step, t, q, .. } = point;
     let dq = q - driver.state.tangential_load;
     let limit = model.friction * driver.state.normal_load;
     let regime = next_regime(dq, 1e-12 * limit);
@@ -593,6 +593,9 @@ fn record_of(
         step,
         t,
         q: s.tangential_load,
+        normal_load: s.normal_load,
+        charge: s.charge,
+        potential: s.potential.unwrap_or(0.0),
         regime,
         phase,
         half_width: s.half_width,

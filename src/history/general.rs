@@ -11,18 +11,22 @@
 //!
 //! ```text
 //! Δδ = Δδx (a stuck point moves with the punch),   D = −Σ w_i ½(q_i + q_i') s_i,
-//! W_P = P Δδz,                                     W_e = φ0 ΔΓ (potential control; else 0)
+//! W_P = P̄ Δδz,                                    W_e = φ̄0 ΔΓ
 //! ```
 //!
 //! with `s_i` the element's mean slip in the step (the half-plane relative to the punch), so
-//! that D ≥ 0 where q opposes the slip.
+//! that D ≥ 0 where q opposes the slip; bars are the means of the step's two states (P, φ0 do
+//! not change under the paper's loads) and ΔΓ is the change of the punch's charge (zero under
+//! a constant charge).
 //!
 //! # Mesh
 //! The band `c ± 1.25a` of the state handed over, graded towards its contact ends
 //! (elements of [`END_SIZE`]·a there) and its stick ends ([`STICK_SIZE`]·a), growing by
 //! [`GROWTH`] per element up to `numerics.general_element_size`·a ([`INNER_SIZE`] by
-//! default). The mesh stays for the rest of the run: the state is the slip reference
-//! of the next step, and it belongs to its mesh.
+//! default). The mesh stays while the normal and electric loads do: the state is the slip
+//! reference of the next step, and it belongs to its mesh. A step that changes either is
+//! solved on a mesh made for the contact before and after it ([`mesh_for_loads`]), with the
+//! state carried onto it ([`Solver::transfer`]).
 
 use std::sync::Arc;
 
@@ -36,7 +40,7 @@ use crate::contact::{ContactModel, ContactState, Electrode};
 use crate::error::SolveFailure;
 
 use super::driver::DriverState;
-use super::load::LoadPoint;
+use super::load::{LoadPoint, PunchLoads};
 use super::record::{StepFailure, StepRecord};
 use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
 
@@ -258,6 +262,14 @@ pub struct GeneralRun {
     /// over at the first step after a take-back ([`GeneralRun::take_back_lost`]) starts at
     /// [`GeneralRun::LOST_TAKE_BACK_WAIT`].
     resume_at: usize,
+    /// Largest element of a mesh made for a new normal or electric load, relative to a
+    /// (`numerics.general_element_size`).
+    #[serde(default = "default_element_size")]
+    element_size: f64,
+}
+
+fn default_element_size() -> f64 {
+    INNER_SIZE
 }
 
 /// A [`GeneralRun`] as written (without its solver).
@@ -272,6 +284,8 @@ pub struct GeneralRunData {
     first_began_at_handover: bool,
     works: [[f64; 2]; 2],
     resume_at: usize,
+    #[serde(default = "default_element_size")]
+    element_size: f64,
 }
 
 /// The loads of a state at tangential load `q`.
@@ -310,6 +324,38 @@ pub fn mesh_for(state: &ContactState, inner: f64) -> Mesh {
     Mesh::graded(c - 1.25 * a, c + 1.25 * a, &focus, GROWTH, inner * a)
 }
 
+/// The mesh for a step from `state` (on `solver`'s mesh) to new normal or electric `loads`:
+/// the band `c ± 1.25 max(a, a')` with elements of [`END_SIZE`]·max(a, a') at the state's
+/// contact ends and at those expected under the new loads (`a' = a` times the ratio of the
+/// frictionless half-widths, [`Solver::first_half_width`]), of [`STICK_SIZE`]·max(a, a') at
+/// the ends of the state's zones, growing by [`GROWTH`] up to `inner`·max(a, a'). A mesh made
+/// afresh at each change keeps the cost of a step bounded over a long history; the price is
+/// the ripple of carrying a state onto other edges ([`Solver::transfer`]).
+pub fn mesh_for_loads(solver: &Solver, state: &GeneralState, loads: Loads, inner: f64) -> Mesh {
+    let (lo, hi) = state.contact_extent().expect("a state in contact");
+    let (c, a) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+    let grown = a * solver.first_half_width(loads) / solver.first_half_width(state.loads);
+    let big = a.max(grown);
+    let mut focus: Vec<Focus> = [c - a, c + a, c - grown, c + grown]
+        .iter()
+        .map(|&at| Focus {
+            at,
+            size: END_SIZE * big,
+        })
+        .collect();
+    let zones = state.zones();
+    for pair in zones.windows(2) {
+        let at = pair[0].2;
+        if at > lo && at < hi {
+            focus.push(Focus {
+                at,
+                size: STICK_SIZE * big,
+            });
+        }
+    }
+    Mesh::graded(c - 1.25 * big, c + 1.25 * big, &focus, GROWTH, inner * big)
+}
+
 impl GeneralRun {
     /// Take over from the driver's committed state, on elements of at most `inner`·a (the
     /// solver from `recall`).
@@ -338,12 +384,14 @@ impl GeneralRun {
             first_began_at_handover: false,
             works: [[0.0; 2]; 2],
             resume_at: 2,
+            element_size: inner,
         }
     }
 
     /// Start from the end of a normal loading the general solver took (`state`, on
-    /// `solver`'s mesh), before any slip phase, with δ counted from there.
-    pub fn loaded(solver: Arc<Solver>, state: GeneralState) -> Self {
+    /// `solver`'s mesh), before any slip phase, with δ counted from there; the meshes made for
+    /// later normal or electric loads have elements of at most `inner`·a.
+    pub fn loaded(solver: Arc<Solver>, state: GeneralState, inner: f64) -> Self {
         Self {
             solver,
             offset: -state.shift,
@@ -355,6 +403,7 @@ impl GeneralRun {
             first_began_at_handover: false,
             works: [[0.0; 2]; 2],
             resume_at: 2,
+            element_size: inner,
         }
     }
 
@@ -372,6 +421,7 @@ impl GeneralRun {
             first_began_at_handover: data.first_began_at_handover,
             works: data.works,
             resume_at: data.resume_at,
+            element_size: data.element_size,
         }
     }
 
@@ -419,28 +469,43 @@ impl GeneralRun {
         self.offset + self.state.shift
     }
 
-    /// Take one load step and commit it (through `recall`); its record.
+    /// Take one load step and commit it (through `recall`); its record. A step whose normal or
+    /// electric load differs from the state's is solved on a mesh made for its contact
+    /// ([`mesh_for_loads`]), the state carried onto it ([`Solver::transfer`]).
     pub fn step(
         &mut self,
         model: &ContactModel,
         point: LoadPoint,
         recall: &mut Recall,
     ) -> Result<StepRecord, StepFailure> {
-        let LoadPoint { step, t, q } = point;
+        let LoadPoint { step, t, q, punch } = point;
         let old = &self.state;
-        let limit = model.friction * old.loads.normal;
+        let loads = Loads {
+            tangential: q,
+            normal: punch.map_or(old.loads.normal, |p| p.normal),
+            electric: punch.map_or(old.loads.electric, |p| p.electric),
+        };
+        let moves = PunchLoads::of(loads.normal, loads.electric)
+            != PunchLoads::of(old.loads.normal, old.loads.electric);
+        let limit = model.friction * old.loads.normal.min(loads.normal);
         let regime = next_regime(q - old.loads.tangential, 1e-12 * limit);
-        let Some(_) = regime.slip_sign() else {
+        if regime.slip_sign().is_none() && !moves {
             let mut rec = self.record(step, t, regime, None);
             rec.q = q;
             return Ok(rec);
+        }
+        // A failed step leaves the run as it was.
+        let (solver, carried) = if moves {
+            let mesh = mesh_for_loads(&self.solver, old, loads, self.element_size);
+            let solver = recall.solver(model, mesh, Options::default());
+            let carried = solver.transfer(old);
+            (solver, Some(carried))
+        } else {
+            (Arc::clone(&self.solver), None)
         };
-        let loads = Loads {
-            tangential: q,
-            ..old.loads
-        };
+        let old = carried.as_ref().unwrap_or(&self.state);
         let (new, report) = recall
-            .step(&self.solver, old, loads)
+            .step(&solver, old, loads)
             .map_err(|failure| StepFailure {
                 step,
                 t,
@@ -467,12 +532,13 @@ impl GeneralRun {
             }
             self.phases_begun += 1;
         }
-        let increments = Increments::between(model, &self.state, &new);
+        let increments = Increments::between(model, old, &new);
         let last = [increments.normal_work, increments.electric_work];
         self.works = [
             [self.works[0][0] + last[0], self.works[0][1] + last[1]],
             last,
         ];
+        self.solver = solver;
         self.state = new;
         self.steps += 1;
         let mut rec = self.record(step, t, regime, Some(&report));
@@ -517,6 +583,9 @@ impl GeneralRun {
             step,
             t,
             q: s.loads.tangential,
+            normal_load: s.loads.normal,
+            charge: s.resultants().2,
+            potential: s.potential,
             regime,
             phase: self.phase,
             half_width: 0.5 * (hi - lo),
@@ -611,15 +680,24 @@ impl Increments {
         let dissipation = -(0..widths.len())
             .map(|i| widths[i] * 0.5 * (old.shear[i] + new.shear[i]) * new.slip[i])
             .sum::<f64>();
+        // Trapezoidal in the loads that vary (exact for those that do not).
+        let mean = |a: f64, b: f64| 0.5 * (a + b);
         let electric_work = match model.electrode {
-            Electrode::ConductingPotential { potential } => {
-                potential * (new.resultants().2 - old.resultants().2)
+            Electrode::ConductingPotential { .. } => {
+                mean(old.loads.electric, new.loads.electric)
+                    * (new.resultants().2 - old.resultants().2)
+            }
+            Electrode::ConductingCharge { .. }
+                if PunchLoads::of(0.0, new.loads.electric)
+                    != PunchLoads::of(0.0, old.loads.electric) =>
+            {
+                mean(old.potential, new.potential) * (new.loads.electric - old.loads.electric)
             }
             _ => 0.0,
         };
         Self {
             dissipation,
-            normal_work: new.loads.normal * (new.approach - old.approach),
+            normal_work: mean(old.loads.normal, new.loads.normal) * (new.approach - old.approach),
             electric_work,
         }
     }

@@ -221,7 +221,12 @@ mod tests {
         let (mut rule, mut reference, mut few) = (Vec::new(), Vec::new(), Vec::new());
         for (i, &(_, t, q)) in steps.iter().take(30).enumerate() {
             let old = driver.state.clone();
-            let point = LoadPoint { step: i + 1, t, q };
+            let point = LoadPoint {
+                step: i + 1,
+                t,
+                q,
+                punch: None,
+            };
             let options = SlipOptions::default();
             advance(
                 &sc.model,

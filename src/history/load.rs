@@ -1,61 +1,130 @@
-//! The prescribed load: the piecewise-linear tangential load Q(t) ([`LoadHistory`]), its
-//! validation, its cut into `max(steps_per_segment, ⌈|ΔQ|/max_step⌉)` equal steps per segment,
-//! and the load at one step ([`LoadPoint`]).
+//! The prescribed loads: the piecewise-linear tangential load Q(t) ([`LoadHistory`]), and with
+//! it, where the history gives them, the normal load P(t) and the electric load (Γ(t) or
+//! φ0(t)) on the same time axis ([`PunchHistory`]); their validation, their cut into steps
+//! ([`LoadHistory::segment_steps`]), and the loads at one step ([`LoadPoint`]).
+//!
+//! # Steps
+//! A segment from point k to point k + 1 is cut into
+//! `n = max(steps_per_segment, ⌈max(|ΔQ|, η|ΔP|)/max_step⌉)` equal steps; a segment along which
+//! no load changes is one step (a hold). The run begins with a ramp from the end of normal
+//! loading (Q = 0, P and the electric load of the normal loading) to the first point, cut by
+//! the same rule, when the first point differs from it.
 
 use serde::Serialize;
 
 use crate::error::Issue;
 
-/// A piecewise-linear tangential load history in N/m.
+/// A piecewise-linear load history: Q(t) in N/m, and optionally P(t) and the electric load.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LoadHistory {
     /// `(t, Q)` points, t strictly increasing (s, N/m).
     pub points: Vec<(f64, f64)>,
+    /// The normal and electric loads at the same points, when the history prescribes them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub punch: Option<PunchHistory>,
     /// Minimum number of steps per segment.
     pub steps_per_segment: usize,
-    /// Largest |ΔQ| of a step (N/m).
+    /// Largest |ΔQ| (and η|ΔP|) of a step (N/m).
     pub max_step: f64,
+}
+
+/// P and the electric load along a [`LoadHistory`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PunchHistory {
+    /// Those of the normal loading, where the history starts from.
+    pub start: PunchLoads,
+    /// At each point of the history.
+    pub points: Vec<PunchLoads>,
+    /// The friction coefficient η, which turns a change of P into the tangential load scale of
+    /// `max_step`.
+    pub friction: f64,
 }
 
 impl LoadHistory {
     /// A history from a lead-in and a cycle block repeated `repeats` times. Cycle times are
     /// relative to the start of each repetition (which is the end of the previous one).
-    pub fn with_cycles(
-        lead_in: &[(f64, f64)],
-        cycle: &[(f64, f64)],
+    pub fn with_cycles<T: Copy>(
+        lead_in: &[(f64, T)],
+        cycle: &[(f64, T)],
         repeats: usize,
-    ) -> Vec<(f64, f64)> {
+    ) -> Vec<(f64, T)> {
         let mut points = lead_in.to_vec();
         for _ in 0..repeats {
             let t0 = points.last().map_or(0.0, |p| p.0);
-            points.extend(cycle.iter().map(|(t, q)| (t0 + t, *q)));
+            points.extend(cycle.iter().map(|(t, v)| (t0 + t, *v)));
         }
         points
     }
 
-    /// The load points of a run, numbered from 1: a ramp from Q = 0 to the first point in one
-    /// segment's worth of steps (when it is not zero), then [`Self::steps`].
+    /// The loads at point `k`.
+    fn loads_at(&self, k: usize) -> (f64, Option<PunchLoads>) {
+        (self.points[k].1, self.punch.as_ref().map(|h| h.points[k]))
+    }
+
+    /// Steps from loads `a` to loads `b` (module docs).
+    fn steps_between(&self, a: (f64, Option<PunchLoads>), b: (f64, Option<PunchLoads>)) -> usize {
+        let (dp, de) = match (a.1, b.1) {
+            (Some(x), Some(y)) => (y.normal - x.normal, y.electric - x.electric),
+            _ => (0.0, 0.0),
+        };
+        let eta = self.punch.as_ref().map_or(0.0, |h| h.friction);
+        let change = (b.0 - a.0).abs().max(eta * dp.abs());
+        if change > 0.0 || dp != 0.0 {
+            self.steps_per_segment
+                .max((change / self.max_step).ceil() as usize)
+                .max(1)
+        } else if de != 0.0 {
+            self.steps_per_segment.max(1)
+        } else {
+            1
+        }
+    }
+
+    /// Steps of the ramp from the end of normal loading to the first point (0 when it is there).
+    pub fn ramp_steps(&self) -> usize {
+        let start = (0.0, self.punch.as_ref().map(|h| h.start));
+        match self.points.first() {
+            Some(_) if self.loads_at(0) != start => self.steps_between(start, self.loads_at(0)),
+            _ => 0,
+        }
+    }
+
+    /// The load points of a run, numbered from 1: a ramp from the end of normal loading to the
+    /// first point (when it differs from it), then [`Self::steps`].
     pub fn load_points(&self) -> Vec<LoadPoint> {
-        let (t0, q0) = self.points.first().copied().unwrap_or((0.0, 0.0));
         let mut steps = Vec::new();
-        if q0.abs() > 0.0 {
-            let n = self
-                .steps_per_segment
-                .max((q0.abs() / self.max_step).ceil() as usize);
-            for i in 1..=n {
-                steps.push((t0, q0 * i as f64 / n as f64));
+        if let Some(&(t0, _)) = self.points.first() {
+            let start = (0.0, self.punch.as_ref().map(|h| h.start));
+            let first = self.loads_at(0);
+            if first != start {
+                let n = self.steps_between(start, first);
+                for i in 1..=n {
+                    let (_, punch) = between(start, first, i as f64 / n as f64);
+                    steps.push((t0, (first.0 * i as f64 / n as f64, punch)));
+                }
             }
         }
-        steps.extend(self.steps().into_iter().map(|(_, t, q)| (t, q)));
+        steps.extend(
+            self.steps_with_punch()
+                .into_iter()
+                .map(|(_, t, loads)| (t, loads)),
+        );
         steps
             .into_iter()
             .enumerate()
-            .map(|(i, (t, q))| LoadPoint { step: i + 1, t, q })
+            .map(|(i, (t, (q, punch)))| LoadPoint {
+                step: i + 1,
+                t,
+                q,
+                punch,
+            })
             .collect()
     }
 
-    /// Check the history before any solving: finite values, strictly increasing times, and
-    /// `|Q| < ηP` at every point (a point at or beyond ηP is gross sliding).
+    /// Check the history before any solving: finite values, strictly increasing times, P > 0
+    /// where given, and `|Q| < ηP` at every point (a point at or beyond ηP is gross sliding;
+    /// both are linear along a segment, so the points suffice). `limit` is ηP of the normal
+    /// loading.
     pub fn validate(&self, path: &str, limit: f64) -> Vec<Issue> {
         let mut issues = Vec::new();
         if self.points.is_empty() {
@@ -71,12 +140,28 @@ impl LoadHistory {
                     format!("{t} s is invalid; it must be finite"),
                 ));
             }
+            let punch = self.punch.as_ref().map(|h| (h.points[i], h.friction));
+            if let Some((loads, _)) = punch {
+                if !(loads.normal.is_finite() && loads.normal > 0.0) {
+                    issues.push(Issue::new(
+                        format!("{path}.points[{i}].p"),
+                        format!("{} N/m is invalid; it must be finite and > 0", loads.normal),
+                    ));
+                }
+                if !loads.electric.is_finite() {
+                    issues.push(Issue::new(
+                        format!("{path}.points[{i}].electric"),
+                        format!("{} is invalid; it must be finite", loads.electric),
+                    ));
+                }
+            }
+            let limit = punch.map_or(limit, |(loads, eta)| eta * loads.normal);
             if !q.is_finite() {
                 issues.push(Issue::new(
                     format!("{path}.points[{i}].q"),
                     format!("{q} N/m is invalid; it must be finite"),
                 ));
-            } else if q.abs() >= limit {
+            } else if limit.is_finite() && q.abs() >= limit {
                 issues.push(Issue::new(
                     format!("{path}.points[{i}].q"),
                     format!(
@@ -113,33 +198,66 @@ impl LoadHistory {
         issues
     }
 
-    /// The number of steps of segment `k` (from point `k` to point `k + 1`):
-    /// `max(steps_per_segment, ⌈|ΔQ|/max_step⌉)`, one for a hold.
+    /// The number of steps of segment `k` (from point `k` to point `k + 1`): module docs.
     pub fn segment_steps(&self, k: usize) -> usize {
-        let (q0, q1) = (self.points[k].1, self.points[k + 1].1);
-        let n = self
-            .steps_per_segment
-            .max(((q1 - q0).abs() / self.max_step).ceil() as usize)
-            .max(1);
-        if (q1 - q0).abs() > 0.0 { n } else { 1 }
+        self.steps_between(self.loads_at(k), self.loads_at(k + 1))
     }
 
     /// The load steps `(t, Q)` after the first point, each with its segment index.
     pub fn steps(&self) -> Vec<(usize, f64, f64)> {
+        self.steps_with_punch()
+            .into_iter()
+            .map(|(k, t, (q, _))| (k, t, q))
+            .collect()
+    }
+
+    /// [`Self::steps`] with P and the electric load of each step.
+    fn steps_with_punch(&self) -> Vec<(usize, f64, (f64, Option<PunchLoads>))> {
         let mut out = Vec::new();
-        for (k, w) in self.points.windows(2).enumerate() {
-            let ((t0, q0), (t1, q1)) = (w[0], w[1]);
+        for k in 0..self.points.len().saturating_sub(1) {
+            let (t0, t1) = (self.points[k].0, self.points[k + 1].0);
+            let (a, b) = (self.loads_at(k), self.loads_at(k + 1));
             let n = self.segment_steps(k);
             for i in 1..=n {
                 let f = i as f64 / n as f64;
-                out.push((k, t0 + f * (t1 - t0), q0 + f * (q1 - q0)));
+                out.push((k, t0 + f * (t1 - t0), between(a, b, f)));
             }
         }
         out
     }
+
+    /// Add the point at time `t` within segment `k` (`t_k < t < t_{k+1}`), its loads
+    /// interpolated: the loads along the history are unchanged.
+    pub fn split_segment(&mut self, k: usize, t: f64) {
+        let ((ta, _), (tb, _)) = (self.points[k], self.points[k + 1]);
+        let f = (t - ta) / (tb - ta);
+        let (q, punch) = between(self.loads_at(k), self.loads_at(k + 1), f);
+        self.points.insert(k + 1, (t, q));
+        if let (Some(h), Some(loads)) = (self.punch.as_mut(), punch) {
+            h.points.insert(k + 1, loads);
+        }
+    }
 }
 
-/// A load point of the history: step number, time (s) and Q (N/m).
+/// The loads a fraction `f` of the way from `a` to `b`.
+fn between(
+    a: (f64, Option<PunchLoads>),
+    b: (f64, Option<PunchLoads>),
+    f: f64,
+) -> (f64, Option<PunchLoads>) {
+    let mix = |x: f64, y: f64| x + f * (y - x);
+    let punch = match (a.1, b.1) {
+        (Some(x), Some(y)) => Some(PunchLoads {
+            normal: mix(x.normal, y.normal),
+            electric: mix(x.electric, y.electric),
+        }),
+        _ => None,
+    };
+    (mix(a.0, b.0), punch)
+}
+
+/// A load point of the history: step number, time (s), Q (N/m), and P and the electric load
+/// where the history prescribes them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LoadPoint {
     /// Step number.
@@ -148,6 +266,26 @@ pub struct LoadPoint {
     pub t: f64,
     /// Tangential load (N/m).
     pub q: f64,
+    /// P and the electric load of the step; `None`: those of the normal loading.
+    pub punch: Option<PunchLoads>,
+}
+
+/// The normal and electric loads on the punch at a point of a history.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PunchLoads {
+    /// P (N/m), > 0.
+    pub normal: f64,
+    /// Γ (C/m) under a charge-controlled conducting punch, φ0 (V) under a potential-controlled
+    /// one; 0 otherwise.
+    pub electric: f64,
+}
+
+impl PunchLoads {
+    /// The loads P and `electric`; two are equal when both values are (a load held constant
+    /// along a history is the same number at every step).
+    pub fn of(normal: f64, electric: f64) -> Self {
+        Self { normal, electric }
+    }
 }
 
 #[cfg(test)]
@@ -158,6 +296,7 @@ mod tests {
     fn history_validation_names_each_point() {
         let h = LoadHistory {
             points: vec![(0.0, 0.0), (1.0, 500.0), (0.5, 700.0)],
+            punch: None,
             steps_per_segment: 4,
             max_step: 10.0,
         };
@@ -178,6 +317,7 @@ mod tests {
     fn steps_cover_each_segment_and_holds_take_one_step() {
         let h = LoadHistory {
             points: vec![(0.0, 0.0), (1.0, 10.0), (2.0, 10.0), (3.0, -10.0)],
+            punch: None,
             steps_per_segment: 2,
             max_step: 4.0,
         };

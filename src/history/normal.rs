@@ -204,7 +204,7 @@ pub fn load_by_steps(
         Options::default(),
     ));
     let (state, loading) = steps(&solver, full, RATIO)?;
-    Ok((GeneralRun::loaded(solver, state), loading))
+    Ok((GeneralRun::loaded(solver, state, inner), loading))
 }
 
 /// A symmetric mesh for the state of a normal loading: band `±1.25a`, elements of
@@ -408,6 +408,7 @@ mod tests {
         );
         let history = LoadHistory {
             points: vec![(0.0, 0.0), (1.0, 100.0), (3.0, -100.0)],
+            punch: None,
             steps_per_segment: 10,
             max_step: 20.0,
         };

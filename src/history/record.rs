@@ -25,6 +25,12 @@ pub struct StepRecord {
     pub t: f64,
     /// Tangential load Q (N/m).
     pub q: f64,
+    /// Normal load P (N/m).
+    pub normal_load: f64,
+    /// Resultant charge Γ on a conducting punch (C/m; 0 without one).
+    pub charge: f64,
+    /// Potential φ0 of a conducting punch (V; 0 without one).
+    pub potential: f64,
     /// Regime.
     pub regime: Regime,
     /// Phase number (0 = normal loading; increments at each reversal).

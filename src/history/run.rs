@@ -7,14 +7,15 @@ use crate::contact::ContactModel;
 use crate::contact::general::Recall;
 use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
+use crate::error::SolveFailure;
 
 use super::driver::{DriverState, SolvedStep, Tried, finish_step, hold_record, try_step};
 use super::general::{GeneralRun, RunOptions, SolverChoice, SolverKind, ZoneCount};
 use super::increments::{IncrementInputs, StepIncrements};
-use super::load::{LoadHistory, LoadPoint};
+use super::load::{LoadHistory, LoadPoint, PunchLoads};
 use super::normal::NormalEnd;
 use super::record::{NoObserver, Observer, StateView, StepFailure, StepRecord};
-use super::regime::{PhaseEvent, next_regime, phase_event};
+use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
 use super::state::{HistoryState, HistoryStateView};
 
 /// A finished run: the records and the final state.
@@ -145,6 +146,32 @@ pub fn continue_run(
     }
     while next < points.len() {
         let point = points[next];
+        if moves_the_punch(model, state, point) {
+            if options.solver == SolverChoice::Spectral {
+                return Some(StepFailure {
+                    step: point.step,
+                    t: point.t,
+                    q: point.q,
+                    regime: Regime::Stick,
+                    failure: SolveFailure::NoAdmissibleState {
+                        reason: "the spectral solver holds P and the electric load fixed; a \
+                                 history that changes them needs the general solver"
+                            .into(),
+                    },
+                });
+            }
+            // The spectral solver's memory cannot describe a past with another normal or
+            // electric load: the general solver takes this step and every later one.
+            if let (None, Some(driver)) = (&state.general, &state.driver) {
+                state.general = Some(GeneralRun::handover(
+                    model,
+                    driver,
+                    options.general_element_size,
+                    &mut recall,
+                ));
+            }
+            state.driver = None;
+        }
         let (mut run, step) = match (state.general.take(), &mut state.driver) {
             (Some(mut run), _) => {
                 let step = run.step(model, point, &mut recall);
@@ -152,15 +179,27 @@ pub fn continue_run(
             }
             (None, None) => unreachable!("a run state holds a driver or a general run"),
             (None, Some(driver)) => {
-                let stop = spectral_stretch(
+                // The spectral stretch ends before the first step that moves the punch.
+                let end = points[next..]
+                    .iter()
+                    .position(|&p| moves_the_punch_from(model, driver, p))
+                    .map_or(points.len(), |k| next + k);
+                let stretch = spectral_stretch(
                     model,
                     disc,
                     driver,
-                    (&points[next..], &turning[next..]),
+                    (&points[next..end], &turning[next..end]),
                     options,
                     (observer, &mut recall),
                     records,
-                )?;
+                );
+                let Some(stop) = stretch else {
+                    if end == points.len() {
+                        return None;
+                    }
+                    next = end;
+                    continue;
+                };
                 next += stop.at;
                 if options.solver == SolverChoice::Spectral {
                     return Some(stop.failure);
@@ -231,6 +270,26 @@ fn keep(records: &mut Vec<StepRecord>, record: StepRecord, all: bool) {
         records.clear();
     }
     records.push(record);
+}
+
+/// Whether the step to `point` changes the normal or the electric load of the state.
+fn moves_the_punch(model: &ContactModel, state: &HistoryState, point: LoadPoint) -> bool {
+    match (&state.general, &state.driver) {
+        (Some(run), _) => point.punch.is_some_and(|punch| {
+            punch != PunchLoads::of(run.state.loads.normal, run.state.loads.electric)
+        }),
+        (None, Some(driver)) => moves_the_punch_from(model, driver, point),
+        (None, None) => unreachable!("a run state holds a driver or a general run"),
+    }
+}
+
+/// Whether the step to `point` changes the normal or the electric load of the spectral
+/// solver's state (whose electric load is the model's).
+fn moves_the_punch_from(model: &ContactModel, driver: &DriverState, point: LoadPoint) -> bool {
+    point.punch.is_some_and(|punch| {
+        let electric = super::general::loads_of(model, 0.0, 0.0).electric;
+        punch != PunchLoads::of(driver.state.normal_load, electric)
+    })
 }
 
 /// The tangential load of the state's last step.

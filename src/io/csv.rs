@@ -83,23 +83,23 @@ const STEPS_BLOCK: usize = 4096;
 
 /// `steps.csv` written as the records arrive, a block of [`STEPS_BLOCK`] records at a time:
 /// the header when made, the rows of each block when it fills, the rest at
-/// [`StepsCsv::finish`]: the bytes of [`steps_table`]`(records, limit).csv()`. A long history
+/// [`StepsCsv::finish`]: the bytes of [`steps_table`]`(records, friction).csv()`. A long history
 /// has hundreds of thousands of steps; this holds a block of them.
 pub(crate) struct StepsCsv<W: std::io::Write> {
     writer: csv::Writer<W>,
     block: Vec<StepRecord>,
-    limit: f64,
+    friction: f64,
 }
 
 impl<W: std::io::Write> StepsCsv<W> {
-    /// Write the header to `out`; `limit` is ηP (N/m).
-    pub(crate) fn new(out: W, limit: f64) -> std::io::Result<Self> {
+    /// Write the header to `out`; `friction` is η.
+    pub(crate) fn new(out: W, friction: f64) -> std::io::Result<Self> {
         let mut writer = csv::Writer::from_writer(out);
-        steps_table(&[], limit).write_header(&mut writer)?;
+        steps_table(&[], friction).write_header(&mut writer)?;
         Ok(Self {
             writer,
             block: Vec::with_capacity(STEPS_BLOCK),
-            limit,
+            friction,
         })
     }
 
@@ -113,7 +113,7 @@ impl<W: std::io::Write> StepsCsv<W> {
     }
 
     fn write_block(&mut self) -> std::io::Result<()> {
-        steps_table(&self.block, self.limit).write_rows(&mut self.writer)?;
+        steps_table(&self.block, self.friction).write_rows(&mut self.writer)?;
         self.block.clear();
         Ok(())
     }
@@ -185,8 +185,8 @@ pub fn cycles_table(cycles: &[CycleRow]) -> Table {
     }
 }
 
-/// `steps.csv`: one row per accepted step; `limit` is ηP (N/m).
-pub fn steps_table(records: &[StepRecord], limit: f64) -> Table {
+/// `steps.csv`: one row per accepted step; `friction` is η.
+pub fn steps_table(records: &[StepRecord], friction: f64) -> Table {
     let r = records;
     let regime = |r: &StepRecord| {
         serde_json::to_value(r.regime)
@@ -199,7 +199,10 @@ pub fn steps_table(records: &[StepRecord], limit: f64) -> Table {
             ("step", Column::Count(r.iter().map(|r| r.step).collect())),
             ("t_s", real(r, |r| r.t)),
             ("Q_N_per_m", real(r, |r| r.q)),
-            ("Q_over_etaP", real(r, |r| r.q / limit)),
+            ("Q_over_etaP", real(r, |r| r.q / (friction * r.normal_load))),
+            ("P_N_per_m", real(r, |r| r.normal_load)),
+            ("charge_C_per_m", real(r, |r| r.charge)),
+            ("potential_V", real(r, |r| r.potential)),
             ("regime", Column::Text(r.iter().map(regime).collect())),
             ("phase", Column::Count(r.iter().map(|r| r.phase).collect())),
             ("a_m", real(r, |r| r.half_width)),
@@ -260,11 +263,11 @@ mod tests {
             })
             .collect();
         assert!(records.len() > 2 * STEPS_BLOCK);
-        let limit = scenario.model.friction * scenario.normal_load;
-        let mut csv = StepsCsv::new(Vec::new(), limit).unwrap();
+        let friction = scenario.model.friction;
+        let mut csv = StepsCsv::new(Vec::new(), friction).unwrap();
         for r in &records {
             csv.push(r).unwrap();
         }
-        assert!(csv.finish().unwrap() == steps_table(&records, limit).csv());
+        assert!(csv.finish().unwrap() == steps_table(&records, friction).csv());
     }
 }

@@ -222,12 +222,11 @@ impl Digest {
         scenario: &Scenario,
         steps: Option<(PathBuf, Box<dyn std::io::Write>)>,
     ) -> Result<Self, Error> {
-        let limit = scenario.model.friction * scenario.normal_load;
         let q_scale = scenario.history.as_ref().map_or(0.0, |h| {
             h.points.iter().map(|p| p.1.abs()).fold(0.0, f64::max)
         });
         let steps = match steps {
-            Some((path, out)) => match StepsCsv::new(out, limit) {
+            Some((path, out)) => match StepsCsv::new(out, scenario.model.friction) {
                 Ok(csv) => Some((path, csv)),
                 Err(source) => return Err(Error::WriteOutput { path, source }),
             },
@@ -800,9 +799,9 @@ mod tests {
             let memory = solve(&scenario, &mut NoObserver).unwrap();
             let steps = memory.records.len();
             assert_eq!(steps, 40 * repeats + 10 + 1);
-            let limit = scenario.model.friction * scenario.normal_load;
+            let friction = scenario.model.friction;
             let read = |name: &str| std::fs::read(out.join(name)).unwrap();
-            assert!(read("steps.csv") == crate::io::csv::steps_table(&memory.records, limit).csv());
+            assert!(read("steps.csv") == crate::io::csv::steps_table(&memory.records, friction).csv());
             let tolerance = scenario.raw.numerics.cycle_tolerance;
             let (cycles, verdict) = crate::analysis::analyse_cycles(&memory.records, tolerance);
             assert!(read("cycles.csv") == cycles_table(&cycles).csv());

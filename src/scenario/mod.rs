@@ -189,10 +189,26 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
     validate_numerics(&mut issues, &raw.numerics);
     let piezo = material.map(|m| m.is_piezoelectric());
     let electrode = resolve_electrode(&mut issues, &raw.punch.electrode, piezo);
-    let history = raw
-        .tangential_history
+    let history = raw.tangential_history.as_ref().map(|h| {
+        let electric = electrode.and_then(|e| match e {
+            Electrode::ConductingCharge { charge } => Some(charge),
+            Electrode::ConductingPotential { potential } => Some(potential),
+            Electrode::None | Electrode::Insulating => None,
+        });
+        resolve_history(&mut issues, h, (raw.friction, raw.normal_load), electric)
+    });
+    let varies = history
         .as_ref()
-        .map(|h| resolve_history(&mut issues, h, raw.friction, raw.normal_load));
+        .and_then(|h| h.history.as_ref())
+        .and_then(|h| h.punch.as_ref())
+        .is_some_and(|p| p.points.iter().any(|&loads| loads != p.start));
+    if varies && raw.numerics.solver == crate::history::SolverChoice::Spectral {
+        issues.push(Issue::new(
+            "numerics.solver",
+            "\"spectral\" is invalid with a history that changes P or the electric load; it must be \
+             \"auto\" or \"general\" (the spectral solver holds them fixed)",
+        ));
+    }
     let span = history.as_ref().and_then(|h| h.span);
     let time_tolerance = validate_output(&mut issues, &raw.output, span, history.is_some());
     match (material, electrode, issues.is_empty()) {

@@ -132,7 +132,8 @@ pub(super) fn default_field_points() -> usize {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum LoadUnit {
-    /// Q as a fraction of ηP (default).
+    /// Q as a fraction of ηP (default), with P the point's normal load where the history gives
+    /// one, else `normal_load`; `max_step` as a fraction of η·`normal_load`.
     #[default]
     FractionOfLimit,
     /// Q in N/m.
@@ -147,11 +148,13 @@ pub struct RawHistory {
     /// Unit of Q and of `max_step`.
     #[serde(default)]
     pub unit: LoadUnit,
-    /// `[t (s), Q]` points.
-    pub points: Vec<(f64, f64)>,
-    /// `[Δt (s), Q]` points of a repeated block.
+    /// `[t (s), Q]` points; `[t, Q, P (N/m)]` where the normal load varies too, and
+    /// `[t, Q, P, Γ (C/m) or φ0 (V)]` where the electric load of a conducting punch varies too
+    /// (every point and cycle point with the same columns).
+    pub points: Vec<Vec<f64>>,
+    /// `[Δt (s), Q, …]` points of a repeated block, with the columns of `points`.
     #[serde(default)]
-    pub cycle: Vec<(f64, f64)>,
+    pub cycle: Vec<Vec<f64>>,
     /// Number of repeats of `cycle` (≥ 0, default 1).
     #[serde(default = "default_repeats")]
     pub repeats: usize,

@@ -3,6 +3,7 @@
 
 use crate::contact::Electrode;
 use crate::error::Issue;
+use crate::history::{LoadHistory, PunchHistory, PunchLoads};
 use crate::material::{IsotropicConstants, Material, preset};
 
 use super::*;
@@ -272,17 +273,69 @@ pub(super) struct CheckedHistory {
     pub(super) span: Option<(f64, f64)>,
 }
 
-/// Check a history's size from its segments, then expand and check it.
+/// The value of column `k` of a raw history point, `default` when it has fewer columns (the
+/// column count is checked by [`history_columns`]).
+fn column(point: &[f64], k: usize, default: f64) -> f64 {
+    point.get(k).copied().unwrap_or(default)
+}
+
+/// The columns of a history's points (2, 3 or 4, the same for every point and cycle point):
+/// an issue for each point that breaks the rule, and the count of the first point.
+fn history_columns(issues: &mut Vec<Issue>, h: &RawHistory, electric: Option<f64>) -> usize {
+    let columns = h.points.first().or(h.cycle.first()).map_or(2, Vec::len);
+    let rule = match electric {
+        Some(_) => "[t, Q], [t, Q, P] or [t, Q, P, electric load]",
+        None => "[t, Q] or [t, Q, P] (an electric column needs a conducting punch)",
+    };
+    let most = if electric.is_some() { 4 } else { 3 };
+    let named = h
+        .points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (format!("tangential_history.points[{i}]"), p))
+        .chain(
+            h.cycle
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (format!("tangential_history.cycle[{i}]"), p)),
+        );
+    for (path, p) in named {
+        if !(2..=most).contains(&p.len()) {
+            issues.push(Issue::new(
+                path,
+                format!("{} columns is invalid; a point must be {rule}", p.len()),
+            ));
+        } else if p.len() != columns && (2..=most).contains(&columns) {
+            issues.push(Issue::new(
+                path,
+                format!(
+                    "{} columns is invalid; it must have the {columns} columns of the first point",
+                    p.len()
+                ),
+            ));
+        }
+    }
+    columns
+}
+
+/// Check a history's size from its segments, then expand and check it. `electric` is the
+/// electric load of the normal loading (Γ or φ0 of a conducting punch; `None` without one).
 pub(super) fn resolve_history(
     issues: &mut Vec<Issue>,
     h: &RawHistory,
-    friction: f64,
-    normal_load: f64,
+    (friction, normal_load): (f64, f64),
+    electric: Option<f64>,
 ) -> CheckedHistory {
     let limit = friction * normal_load;
+    let columns = history_columns(issues, h, electric);
     let scale = match h.unit {
         LoadUnit::FractionOfLimit => limit,
         LoadUnit::NewtonPerMetre => 1.0,
+    };
+    // Q of a point in N/m: a fraction of η times the point's own P.
+    let q_of = |p: &[f64]| match h.unit {
+        LoadUnit::FractionOfLimit => column(p, 1, 0.0) * (friction * column(p, 2, normal_load)),
+        LoadUnit::NewtonPerMetre => column(p, 1, 0.0),
     };
     let max_step = h.max_step.map_or(0.05 * limit, |m| m * scale);
     if friction <= 0.0 {
@@ -293,7 +346,11 @@ pub(super) fn resolve_history(
     }
     let sized = limit.is_finite() && limit > 0.0 && h.steps_per_segment > 0;
     let steps = if sized && max_step.is_finite() && max_step > 0.0 {
-        h.load_steps(scale, max_step)
+        h.load_steps(
+            &|p| (q_of(p), friction * column(p, 2, normal_load)),
+            limit,
+            max_step,
+        )
     } else {
         // Each segment takes at least one step.
         h.point_count() - 1.0
@@ -317,16 +374,40 @@ pub(super) fn resolve_history(
             span: h.span(),
         };
     }
-    let lead: Vec<(f64, f64)> = h.points.iter().map(|(t, q)| (*t, q * scale)).collect();
-    let cycle: Vec<(f64, f64)> = h.cycle.iter().map(|(t, q)| (*t, q * scale)).collect();
+    let start = PunchLoads {
+        normal: normal_load,
+        electric: electric.unwrap_or(0.0),
+    };
+    let punch_of = |p: &[f64]| PunchLoads {
+        normal: column(p, 2, start.normal),
+        electric: column(p, 3, start.electric),
+    };
+    let time = |p: &[f64]| column(p, 0, 0.0);
+    let lead: Vec<(f64, f64)> = h.points.iter().map(|p| (time(p), q_of(p))).collect();
+    let cycle: Vec<(f64, f64)> = h.cycle.iter().map(|p| (time(p), q_of(p))).collect();
     let repeats = if cycle.is_empty() { 0 } else { h.repeats };
-    let points = crate::history::LoadHistory::with_cycles(&lead, &cycle, repeats);
-    let history = crate::history::LoadHistory {
+    let points = LoadHistory::with_cycles(&lead, &cycle, repeats);
+    let punch = (columns > 2).then(|| {
+        let lead: Vec<(f64, PunchLoads)> =
+            h.points.iter().map(|p| (time(p), punch_of(p))).collect();
+        let cycle: Vec<(f64, PunchLoads)> =
+            h.cycle.iter().map(|p| (time(p), punch_of(p))).collect();
+        PunchHistory {
+            start,
+            points: LoadHistory::with_cycles(&lead, &cycle, repeats)
+                .into_iter()
+                .map(|p| p.1)
+                .collect(),
+            friction,
+        }
+    });
+    let history = LoadHistory {
         points,
+        punch,
         steps_per_segment: h.steps_per_segment,
         max_step,
     };
-    if friction > 0.0 && limit.is_finite() && limit > 0.0 {
+    if friction > 0.0 && limit.is_finite() && limit > 0.0 && (2..=4).contains(&columns) {
         issues.extend(history.validate("tangential_history", limit));
     }
     validate_cycle(issues, &h.cycle);
@@ -342,7 +423,8 @@ pub(super) fn resolve_history(
 }
 
 /// The cycle's times: strictly increasing and > 0.
-pub(super) fn validate_cycle(issues: &mut Vec<Issue>, cycle: &[(f64, f64)]) {
+pub(super) fn validate_cycle(issues: &mut Vec<Issue>, cycle: &[Vec<f64>]) {
+    let cycle: Vec<(f64, f64)> = cycle.iter().map(|p| (column(p, 0, 0.0), 0.0)).collect();
     for (i, w) in cycle.windows(2).enumerate() {
         if w[1].0 <= w[0].0 {
             issues.push(Issue::new(
@@ -382,24 +464,20 @@ pub(super) fn segment_steps(dq: f64, steps_per_segment: f64, max_step: f64) -> f
     }
 }
 
-/// Load steps of a run of an expanded history: the ramp to the first point and the segments.
-pub(super) fn load_step_count(h: &crate::history::LoadHistory) -> f64 {
-    let sps = h.steps_per_segment as f64;
-    let ramp = h
-        .points
-        .first()
-        .map_or(0.0, |&(_, q)| ramp_steps(q, sps, h.max_step));
-    ramp + h
-        .points
-        .windows(2)
-        .map(|w| segment_steps(w[1].1 - w[0].1, sps, h.max_step))
-        .sum::<f64>()
+/// Load steps of a run of an expanded history: the ramp to the first point and the segments
+/// (as f64: a count that overflows is a count too large).
+pub(super) fn load_step_count(h: &LoadHistory) -> f64 {
+    h.ramp_steps() as f64
+        + (0..h.points.len().saturating_sub(1))
+            .map(|k| h.segment_steps(k) as f64)
+            .sum::<f64>()
 }
 
-/// Steps of the ramp from Q = 0 to the first point `q` (as `history::run_history` takes them).
-pub(super) fn ramp_steps(q: f64, steps_per_segment: f64, max_step: f64) -> f64 {
-    if q.abs() > 0.0 {
-        steps_per_segment.max((q.abs() / max_step).ceil())
+/// Steps of the ramp from the end of normal loading to the first point, whose loads differ
+/// from it by `change` (N/m, as [`segment_steps`]).
+pub(super) fn ramp_steps(change: f64, steps_per_segment: f64, max_step: f64) -> f64 {
+    if change > 0.0 {
+        steps_per_segment.max((change / max_step).ceil())
     } else {
         0.0
     }
@@ -417,13 +495,20 @@ impl RawHistory {
     }
 
     /// Load steps of a run (the ramp to the first point, the lead-in, each repeat of the
-    /// cycle), counted from the segments without repeating the cycle; `scale` turns Q into
-    /// N/m, `max_step` is in N/m.
-    pub(super) fn load_steps(&self, scale: f64, max_step: f64) -> f64 {
+    /// cycle), counted from the segments without repeating the cycle; `loads` gives a point's
+    /// Q and ηP in N/m, the first from the end of normal loading at `(0, start)`; `max_step` is
+    /// in N/m.
+    pub(super) fn load_steps(
+        &self,
+        loads: &dyn Fn(&[f64]) -> (f64, f64),
+        start: f64,
+        max_step: f64,
+    ) -> f64 {
         let sps = self.steps_per_segment as f64;
-        let steps = |q0: f64, q1: f64| segment_steps(q1 * scale - q0 * scale, sps, max_step);
-        let within =
-            |pts: &[(f64, f64)]| pts.windows(2).map(|w| steps(w[0].1, w[1].1)).sum::<f64>();
+        let change =
+            |(q0, p0): (f64, f64), (q1, p1): (f64, f64)| (q1 - q0).abs().max((p1 - p0).abs());
+        let steps = |a: &[f64], b: &[f64]| segment_steps(change(loads(a), loads(b)), sps, max_step);
+        let within = |pts: &[Vec<f64>]| pts.windows(2).map(|w| steps(&w[0], &w[1])).sum::<f64>();
         let repeats = if self.cycle.is_empty() {
             0.0
         } else {
@@ -433,14 +518,16 @@ impl RawHistory {
             .points
             .first()
             .or(self.cycle.first().filter(|_| repeats > 0.0));
-        let mut total = first.map_or(0.0, |p| ramp_steps(p.1 * scale, sps, max_step));
+        let mut total = first.map_or(0.0, |p| {
+            ramp_steps(change((0.0, start), loads(p)), sps, max_step)
+        });
         total += within(&self.points);
         if let (Some(c0), Some(c1)) = (self.cycle.first(), self.cycle.last())
             && repeats > 0.0
         {
             let cycle = within(&self.cycle);
-            let join = self.points.last().map_or(0.0, |p| steps(p.1, c0.1));
-            total += join + cycle + (repeats - 1.0) * (steps(c1.1, c0.1) + cycle);
+            let join = self.points.last().map_or(0.0, |p| steps(p, c0));
+            total += join + cycle + (repeats - 1.0) * (steps(c1, c0) + cycle);
         }
         total
     }
@@ -453,18 +540,19 @@ impl RawHistory {
         } else {
             self.repeats as f64
         };
-        let t_lead = self.points.last().map_or(0.0, |p| p.0);
-        let first = self.points.first().map(|p| p.0).or_else(|| {
+        let t = |p: &Vec<f64>| column(p, 0, 0.0);
+        let t_lead = self.points.last().map_or(0.0, t);
+        let first = self.points.first().map(t).or_else(|| {
             self.cycle
                 .first()
                 .filter(|_| repeats > 0.0)
-                .map(|c| t_lead + c.0)
+                .map(|c| t_lead + t(c))
         })?;
         let last = self
             .cycle
             .last()
             .filter(|_| repeats > 0.0)
-            .map_or(t_lead, |c| t_lead + repeats * c.0);
+            .map_or(t_lead, |c| t_lead + repeats * t(c));
         Some((first, last))
     }
 }

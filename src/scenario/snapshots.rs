@@ -1,5 +1,6 @@
 //! Snapshot times made step times: a time that falls between steps adds the point (t, Q(t))
-//! of the piecewise-linear history, splitting its segment.
+//! of the piecewise-linear history (with P and the electric load where it gives them),
+//! splitting its segment.
 
 /// Make every snapshot time (strictly increasing) a step time of `history`: where no step
 /// (nor the end of normal loading, nor the first point) falls within `tol` of a time, add the
@@ -40,9 +41,8 @@ pub(super) fn insert_snapshot_point(
         return None;
     }
     let k = above - 1;
-    let ((ta, qa), (tb, qb)) = (history.points[k], history.points[k + 1]);
-    let q = qa + (t - ta) / (tb - ta) * (qb - qa);
-    history.points.insert(k + 1, (t, q));
+    let ta = history.points[k].0;
+    history.split_segment(k, t);
     Some(ta)
 }
 

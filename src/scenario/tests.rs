@@ -378,7 +378,10 @@ mod history {
         let h = s.history.as_ref().unwrap();
         assert_eq!(load_step_count(h) as usize, 130);
         let raw = s.raw.tangential_history.as_ref().unwrap();
-        assert_eq!(raw.load_steps(600.0, h.max_step) as usize, 130);
+        assert_eq!(
+            raw.load_steps(&|p| (p[1] * 600.0, 600.0), 600.0, h.max_step) as usize,
+            130
+        );
         let text = DEFAULT_SCENARIO.replace("\"repeats\": 3", "\"repeats\": 1000000000000000000");
         let found = issues_of(&text);
         assert_eq!(found.len(), 1);
@@ -470,6 +473,7 @@ mod history {
                 .collect();
             let base = crate::history::LoadHistory {
                 points,
+                punch: None,
                 steps_per_segment: 1 + (next() * 12.0) as usize,
                 max_step: 0.02 + next() * 0.3,
             };

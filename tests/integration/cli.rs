@@ -59,6 +59,9 @@ struct Derived {
 #[allow(dead_code)] // pins the schema: every field must be there, not every one is asserted on
 struct LoadHistory {
     points: Vec<(f64, f64)>,
+    /// P and the electric load at each point, where the history gives them.
+    #[serde(default)]
+    punch: Option<serde_json::Value>,
     steps_per_segment: usize,
     max_step: f64,
 }
@@ -171,7 +174,7 @@ fn read_summary(dir: &Path) -> Summary {
 }
 
 const FIELDS_HEADER: &str = "x_m,p_Pa,q_Pa,g_C_per_m2,sigma_xx_Pa,d_x_C_per_m2";
-const STEPS_HEADER: &str = "step,t_s,Q_N_per_m,Q_over_etaP,regime,phase,a_m,e_m,stick_lo_m,stick_hi_m,\
+const STEPS_HEADER: &str = "step,t_s,Q_N_per_m,Q_over_etaP,P_N_per_m,charge_C_per_m,potential_V,regime,phase,a_m,e_m,stick_lo_m,stick_hi_m,\
 left_slip_sign,right_slip_sign,newton_iterations,evaluations,residual,stick_excess,slip_reversal,\
 delta_m,dissipation_J_per_m,solver,stick_zones,slip_zones,slip_sign_changes";
 const CYCLES_HEADER: &str = "cycle,first_step,last_step,Q_start_N_per_m,Q_min_N_per_m,\
@@ -403,8 +406,9 @@ fn run_scenario(name: &str) -> (tempfile::TempDir, PathBuf, Summary) {
 }
 
 /// The scenarios with a test of their own below; a file in `scenarios/` without one fails.
-const SCENARIOS: [&str; 13] = [
+const SCENARIOS: [&str; 15] = [
     "baseline",
+    "charge_history",
     "cattaneo_mindlin_uncoupled",
     "figure3_history",
     "figure3_history_insulating",
@@ -414,6 +418,7 @@ const SCENARIOS: [&str; 13] = [
     "flat_punch_fretting",
     "insulating",
     "many_cycles",
+    "normal_load_in_phase",
     "partial_unload_reload",
     "small_friction_below_gamma1",
     "variable_amplitude",
@@ -494,6 +499,67 @@ fn scenario_small_friction_below_gamma1() {
             .all(|l| l.split(',').nth(solver) == Some("general"))
     );
     assert!(out.join("fields/normal_loading.csv").exists());
+}
+
+/// The column of `steps.csv` named `name`.
+fn column(header: &str, rows: &[Vec<f64>], name: &str) -> Vec<f64> {
+    let k = header.split(',').position(|c| c == name).unwrap();
+    rows.iter().map(|r| r[k]).collect()
+}
+
+/// P and Q in phase on the uncoupled half-plane (ν = 0.5), `[t, Q, P]` points: the general
+/// solver takes every step after the first change of P, Q/(ηP) follows the current P, and
+/// with |ΔQ| = 0.5 |ΔP| > η|ΔP| the ends slip at every cycle, at an energy that settles.
+#[test]
+fn scenario_normal_load_in_phase() {
+    let (_tmp, out, s) = run_scenario("normal_load_in_phase");
+    assert_eq!(s.solver.general_steps, 160);
+    let (header, rows) = read_csv(&out.join("steps.csv"));
+    assert_eq!(rows.len(), 161);
+    let (t, q, p) = (
+        column(&header, &rows, "t_s"),
+        column(&header, &rows, "Q_N_per_m"),
+        column(&header, &rows, "P_N_per_m"),
+    );
+    let ratio = column(&header, &rows, "Q_over_etaP");
+    for k in 0..rows.len() {
+        // P and Q are linear in t on each segment: P = 2240 + 2 Q here.
+        assert!((p[k] - 2240.0 - 2.0 * q[k]).abs() < 1e-9, "step {k}");
+        // steps.csv has 11 significant digits.
+        assert!((ratio[k] - q[k] / (0.3 * p[k])).abs() < 1e-10 && ratio[k].abs() < 1.0);
+    }
+    assert!((t[10] - 1.0).abs() < 1e-12 && (p[10] - 2840.0).abs() < 1e-9);
+    let (ch, cycles) = read_csv(&out.join("cycles.csv"));
+    let work = column(&ch, &cycles, "friction_work_J_per_m");
+    assert!(
+        work[1] > 0.0 && (work[2] / work[1] - 1.0).abs() < 1e-2,
+        "{work:?}"
+    );
+}
+
+/// A charge history at constant P and Q on PZT-4 below Γ1 (`[t, Q, P, Γ]` points): the change
+/// of the charge alone makes the contact ends slip (friction work in steps where Q and P do
+/// not change), and the charge column follows the history.
+#[test]
+fn scenario_charge_history() {
+    let (_tmp, out, s) = run_scenario("charge_history");
+    assert_eq!(s.solver.general_steps, 90);
+    let (header, rows) = read_csv(&out.join("steps.csv"));
+    assert_eq!(rows.len(), 101);
+    let (q, p, charge, work) = (
+        column(&header, &rows, "Q_N_per_m"),
+        column(&header, &rows, "P_N_per_m"),
+        column(&header, &rows, "charge_C_per_m"),
+        column(&header, &rows, "dissipation_J_per_m"),
+    );
+    assert!((charge[20] - 4e-7).abs() < 1e-18 && charge[30].abs() < 1e-18);
+    let held = (11..rows.len()).filter(|&k| (q[k] - 400.0).abs() < 1e-9 && p[k] == 2000.0);
+    assert_eq!(held.clone().count(), 90);
+    // The mid-step traction of the first step after the charge turns back makes the step's
+    // dissipation −1.4e−11 J/m at the most, against 3.1e−8 J/m in the steps that slip.
+    let most = work.iter().cloned().fold(0.0, f64::max);
+    assert!(held.clone().all(|k| work[k] >= -1e-3 * most));
+    assert!(held.filter(|&k| work[k] > 1e-3 * most).count() > 60);
 }
 
 /// The flat punch with rounded corners on the uncoupled half-plane (ν = 0.5): the general

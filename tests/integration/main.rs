@@ -4,6 +4,7 @@ mod accelerations;
 mod cli;
 mod fuzz;
 mod hybrid;
+mod load_paths;
 mod output_safety;
 mod reference;
 mod resume;

@@ -83,6 +83,7 @@ fn run_points(
     use fretsim::history::{LoadHistory, NoObserver, run_history};
     let history = LoadHistory {
         points,
+        punch: None,
         steps_per_segment,
         max_step,
     };
@@ -124,6 +125,7 @@ fn records_of(
     use fretsim::history::{LoadHistory, NoObserver, run_history};
     let history = LoadHistory {
         points,
+        punch: None,
         steps_per_segment: 10,
         max_step: 0.05 * b.lim,
     };
@@ -635,6 +637,7 @@ fn reference_cattaneo_mindlin_deresiewicz_masing() {
         .collect();
     let history = LoadHistory {
         points,
+        punch: None,
         steps_per_segment: 8,
         max_step: 0.05 * lim,
     };
@@ -1476,6 +1479,7 @@ fn pipelined_history_matches_sequential_steps() {
             (2.0, 0.4 * b.lim),
             (3.0, -0.2 * b.lim),
         ],
+        punch: None,
         steps_per_segment: 3,
         max_step: 0.2 * b.lim,
     };
@@ -1493,7 +1497,12 @@ fn pipelined_history_matches_sequential_steps() {
         .steps()
         .into_iter()
         .enumerate()
-        .map(|(i, (_, t, q))| LoadPoint { step: i + 1, t, q })
+        .map(|(i, (_, t, q))| LoadPoint {
+            step: i + 1,
+            t,
+            q,
+            punch: None,
+        })
         .collect();
     let step = |driver: &mut DriverState, point: &LoadPoint| {
         advance(&b.model, &b.disc, driver, *point, options, &mut NoObserver).unwrap()
@@ -1745,13 +1754,19 @@ fn repeated_steps_take_the_checks_and_increments_they_would_compute() {
         let b = baseline(m);
         let history = LoadHistory {
             points: half_amplitude_cycles(b.lim, 9),
+            punch: None,
             steps_per_segment: 10,
             max_step: 0.05 * b.lim,
         };
         let mut driver = DriverState::after_normal_loading(&b.normal);
         let mut pairs = Vec::new();
         for (i, (_, t, q)) in history.steps().into_iter().enumerate() {
-            let point = LoadPoint { step: i + 1, t, q };
+            let point = LoadPoint {
+                step: i + 1,
+                t,
+                q,
+                punch: None,
+            };
             let options = SlipOptions::default();
             let Ok(Solved::Slip(solved)) =
                 solve_step(&b.model, &b.disc, &mut driver, point, options)
@@ -1916,6 +1931,7 @@ fn batched_fields_equal_the_one_point_fields() {
     let b = baseline(32);
     let history = LoadHistory {
         points: vec![(0.0, 0.0), (1.0, 0.5 * b.lim), (2.0, 0.2 * b.lim)],
+        punch: None,
         steps_per_segment: 6,
         max_step: 0.1 * b.lim,
     };
@@ -2121,6 +2137,7 @@ fn a_recalled_step_from_another_start_computes_its_own_increments() {
     );
     let history = fretsim::history::LoadHistory {
         points,
+        punch: None,
         steps_per_segment: 1,
         max_step: 0.15 * b.lim,
     };

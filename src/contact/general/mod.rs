@@ -131,6 +131,7 @@ mod dense;
 mod handover;
 mod normal;
 mod recall;
+mod remesh;
 mod tangential;
 
 #[cfg(test)]
@@ -274,6 +275,8 @@ pub struct Solver {
     electrode: Electrode,
     mesh: Mesh,
     influence: Influence,
+    /// The datum d of the logarithmic kernel (m).
+    reference_distance: f64,
     options: Options,
 }
 
@@ -367,6 +370,7 @@ impl Solver {
             electrode: model.electrode,
             mesh,
             influence,
+            reference_distance: model.reference_distance,
             options,
         }
     }

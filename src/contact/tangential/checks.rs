@@ -185,7 +185,12 @@ mod tests {
         let mut worst: f64 = 0.0;
         for (i, &(_, t, q)) in steps.iter().take(30).enumerate() {
             let old = driver.state.clone();
-            let point = LoadPoint { step: i + 1, t, q };
+            let point = LoadPoint {
+                step: i + 1,
+                t,
+                q,
+                punch: None,
+            };
             advance_driver(&sc, &disc, &mut driver, point);
             let new = &driver.state;
             if new.traction.stick.is_none() || old.traction.stick.is_none() {

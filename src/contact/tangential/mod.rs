@@ -573,7 +573,12 @@ mod tests {
         let fine = 4 * crate::contact::field_rule_nodes(disc.nodes());
         let (mut rule, mut reference) = (Vec::new(), Vec::new());
         for (i, &(_, t, q)) in steps.iter().take(30).enumerate() {
-            let point = LoadPoint { step: i + 1, t, q };
+            let point = LoadPoint {
+                step: i + 1,
+                t,
+                q,
+                punch: None,
+            };
             advance_driver(&sc, &disc, &mut driver, point);
             let s = &driver.state;
             // The contact centre at normal loading lies in every stick zone of these phases.

@@ -890,6 +890,7 @@ mod tests {
                     step,
                     t: step as f64,
                     q: 0.05 * step as f64 * limit,
+                    punch: None,
                 };
                 advance_driver(&sc, &disc, &mut driver, point);
                 if step >= 5 {
