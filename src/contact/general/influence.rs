@@ -6,7 +6,7 @@ use faer::{Accum, ColMut, ColRef, Mat, Par};
 use super::mesh::Mesh;
 
 /// `G(t) = t²/2 · ln(|t|/d) − 3t²/4`, with `G'' = ln(|t|/d)` and `G(0) = 0`.
-fn g2(t: f64, d: f64) -> f64 {
+pub(super) fn g2(t: f64, d: f64) -> f64 {
     if t == 0.0 {
         0.0
     } else {

@@ -22,7 +22,7 @@
 
 use std::f64::consts::PI;
 
-use super::influence::log_pair;
+use super::influence::g2;
 use super::{ElementState, GeneralState, Mesh, Solver};
 
 /// `∫_{x1}^{x2} ∫_{s1}^{s2} sign(x − s) ds dx`, exact (`F'' = sign`, `F(t) = t|t|/2`).
@@ -57,19 +57,29 @@ impl Solver {
         let c = &self.coefficients;
         let w13 = c.electric.map_or(0.0, |e| e.2);
         let d = self.reference_distance;
+        // The old elements that carry a traction, and `G(x_a − s_b)` at every pair of a new
+        // edge and one of their edges: each element integral is four entries of the table.
+        let loaded = |j: usize| old.pressure[j] != 0.0 || old.shear[j] != 0.0 || old.charge[j] != 0.0;
+        let j0 = (0..from.len()).find(|&j| loaded(j)).unwrap_or(0);
+        let j1 = (0..from.len()).rfind(|&j| loaded(j)).unwrap_or(0);
+        let old_edges = &from.edges[j0..=j1 + 1];
+        let width = old_edges.len();
+        let table: Vec<f64> = to
+            .edges
+            .iter()
+            .flat_map(|&x| old_edges.iter().map(move |&s| g2(x - s, d)))
+            .collect();
         let displacement = (0..to.len())
             .map(|i| {
                 let (x1, x2) = (to.edges[i], to.edges[i + 1]);
+                let (lower, upper) = (&table[i * width..], &table[(i + 1) * width..]);
                 let mut u = 0.0;
-                for j in 0..from.len() {
+                for (b, j) in (j0..=j1).enumerate() {
                     let (p, q, g) = (old.pressure[j], old.shear[j], old.charge[j]);
-                    if p == 0.0 && q == 0.0 && g == 0.0 {
-                        continue;
-                    }
                     let (s1, s2) = (from.edges[j], from.edges[j + 1]);
                     let sign = sign_pair(x1, x2, s1, s2);
-                    u += -0.5 * c.w12 * sign * p - 0.5 * w13 * sign * g
-                        - (c.y11 / PI) * log_pair(x1, x2, s1, s2, d) * q;
+                    let log = upper[b] - lower[b] - upper[b + 1] + lower[b + 1];
+                    u += -0.5 * c.w12 * sign * p - 0.5 * w13 * sign * g - (c.y11 / PI) * log * q;
                 }
                 u / (x2 - x1)
             })
