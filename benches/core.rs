@@ -464,8 +464,40 @@ fn general_step(c: &mut Criterion) {
     g.finish();
 }
 
+/// One cycle of P and Q in phase (`scenarios/normal_load_in_phase.json`, 40 steps, each on a
+/// mesh made for its contact), against the same cycle of Q at constant P taken by the general
+/// solver (40 steps on one mesh): the cost of a step that changes P.
+fn load_paths(c: &mut Criterion) {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/normal_load_in_phase.json"
+    ))
+    .unwrap();
+    let in_phase = text.replace(r#""repeats": 4"#, r#""repeats": 1"#);
+    let constant = in_phase
+        .replace(", 2840.0]", ", 2240.0]")
+        .replace(", 1640.0]", ", 2240.0]")
+        .replace(
+            r#""normal_load": 2240.0,"#,
+            r#""normal_load": 2240.0, "numerics": {"solver": "general"},"#,
+        );
+    let mut g = c.benchmark_group("load_paths/cycle");
+    g.sample_size(10);
+    for (name, text) in [("in_phase_p", in_phase), ("constant_p", constant)] {
+        let raw = fretsim::parse(&text, std::path::Path::new("bench.json")).unwrap();
+        let sc = fretsim::validate(raw).unwrap();
+        g.bench_function(BenchmarkId::from_parameter(name), |b| {
+            b.iter(|| {
+                black_box(fretsim::io::solve(&sc, &mut fretsim::history::NoObserver).unwrap())
+            })
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    load_paths,
     general_step,
     kernels,
     normal,
