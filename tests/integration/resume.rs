@@ -39,7 +39,7 @@ fn full_run(scenario: Option<&Path>, out: &Path) {
 /// and killed again at the resumed run's second checkpoint (the fifth of the run), then
 /// resumed to the end: every file of the output folder (CSV, JSON, SVG, HTML, manifest) is
 /// the uninterrupted run's, byte for byte, and no hidden folder is left beside it. The same
-/// for the Figure-4 history with its PNG plots, killed once.
+/// for a history that changes P, and the Figure-4 history with its PNG plots, killed once.
 #[test]
 fn a_run_killed_and_resumed_writes_the_uninterrupted_runs_output_byte_for_byte() {
     let tmp = tempfile::tempdir().unwrap();
@@ -62,6 +62,16 @@ fn a_run_killed_and_resumed_writes_the_uninterrupted_runs_output_byte_for_byte()
         .filter(|n| n.starts_with('.'))
         .collect();
     assert!(hidden.is_empty(), "{hidden:?}");
+
+    // A history that changes P: the general solver's run (its mesh made for the last change
+    // of P) is the checkpoint's state.
+    let in_phase = scenario_path("normal_load_in_phase");
+    let (full, part) = (tmp.path().join("full_p"), tmp.path().join("part_p"));
+    full_run(Some(&in_phase), &full);
+    killed(paused_run(Some(&in_phase), &part, "checkpoint 3"));
+    let o = resume(Some(&in_phase), &part, None);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(snapshot(&part), snapshot(&full));
 
     let figure4 = scenario_path("figure4_fretting");
     let (full, part) = (tmp.path().join("full4"), tmp.path().join("part4"));
