@@ -1,6 +1,7 @@
-//! The load-history driver: a piecewise-linear tangential load Q(t) walked step by step through
-//! a closed set of solver states, with the strain memory stored at the start of every monotonic
-//! phase (seed Section 4; `docs/formulation.md` §4).
+//! The load-history driver: a piecewise-linear tangential load Q(t) (and, where the history
+//! gives them, the normal load P(t) and the electric load Γ(t) or φ0(t)) walked step by step
+//! through a closed set of solver states, with the strain memory stored at the start of every
+//! monotonic phase (seed Section 4; `docs/formulation.md` §4).
 //!
 //! # States and transitions
 //! [`Regime`] is closed: normal loading, stick (hold), forward slip, reverse slip. The next
@@ -13,7 +14,7 @@
 //!
 //! # Steps
 //! Each segment `(t0, Q0) → (t1, Q1)` is cut into `max(steps_per_segment, ⌈|ΔQ|/max_step⌉)`
-//! equal steps ([`LoadHistory::load_points`]). Each step is tried by [`try_step`] from the
+//! equal steps (`η|ΔP|` counts as `|ΔQ|` where P varies; [`LoadHistory::load_points`]). Each step is tried by [`try_step`] from the
 //! committed state and memory ([`solve_slip`] solves and checks it) and leaves the driver as it
 //! was; [`DriverState::commit`] then stores it (trial, then commit). A failure stops the run
 //! with the step, t, Q and regime; the steps already solved are kept by the caller (observer).
@@ -49,6 +50,10 @@
 //! the step ([`SolverKind`]) and the zone structure ([`ZoneCount`]). Where the spectral
 //! solver has no normal-loading state, the general solver loads the contact by steps and
 //! holds every step of the history ([`NormalEnd`]; the state then has no spectral driver).
+//! The spectral solver holds P and the electric load fixed (its memory is a past at the
+//! normal loading's P and Γ): the first step that changes either is handed to the general
+//! solver, which holds every later step, and the spectral driver is dropped. The regime of
+//! such a step is still that of ΔQ (stick where Q holds), though its contact may slip.
 //!
 //! # Warm start
 //! Inside a phase the geometry of the step (stick ends, contact half-width and centre) is
