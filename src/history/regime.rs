@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 pub enum Regime {
     /// Monotonic normal loading (Spence's self-similar state).
     NormalLoading,
-    /// Hold: ΔQ = 0, whole state unchanged.
+    /// Hold: ΔQ = 0; the state is unchanged unless the step changes P or the electric load.
     Stick,
     /// ΔQ > 0: both slip zones carry `q = +ηp`.
     ForwardSlip,
