@@ -11,7 +11,7 @@
 //!
 //! ```text
 //! Δδ = Δδx (a stuck point moves with the punch),   D = −Σ w_i ½(q_i + q_i') s_i,
-//! W_P = P̄ Δδz,                                    W_e = φ̄0 ΔΓ
+//! W_P = P̄ Δδz,                                    W_e = −φ̄0 ΔΓ
 //! ```
 //!
 //! with `s_i` the element's mean slip in the step (the half-plane relative to the punch), so
@@ -684,14 +684,14 @@ impl Increments {
         let mean = |a: f64, b: f64| 0.5 * (a + b);
         let electric_work = match model.electrode {
             Electrode::ConductingPotential { .. } => {
-                mean(old.loads.electric, new.loads.electric)
+                -mean(old.loads.electric, new.loads.electric)
                     * (new.resultants().2 - old.resultants().2)
             }
             Electrode::ConductingCharge { .. }
                 if PunchLoads::of(0.0, new.loads.electric)
                     != PunchLoads::of(0.0, old.loads.electric) =>
             {
-                mean(old.potential, new.potential) * (new.loads.electric - old.loads.electric)
+                -mean(old.potential, new.potential) * (new.loads.electric - old.loads.electric)
             }
             _ => 0.0,
         };

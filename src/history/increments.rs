@@ -33,7 +33,7 @@ pub struct StepIncrements {
     pub dissipation: f64,
     /// Work of P, `P Δδn` (J/m).
     pub normal_work: f64,
-    /// Work of the electric load, `φ̄0 ΔΓ` (J/m).
+    /// Work of the electric load, `−φ̄0 ΔΓ` (J/m; [`super::StepRecord::electric_work`]).
     pub electric_work: f64,
     /// `ux` of the new state at the anchor (m).
     pub new_ux: f64,
@@ -69,7 +69,7 @@ impl StepIncrements {
             None => (0.0, 0.0),
         };
         let electric_work = match (old.potential, new.potential) {
-            (Some(a), Some(b)) => 0.5 * (a + b) * (new.charge - old.charge),
+            (Some(a), Some(b)) => -0.5 * (a + b) * (new.charge - old.charge),
             _ => 0.0,
         };
         Self {

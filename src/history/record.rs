@@ -64,7 +64,12 @@ pub struct StepRecord {
     pub dissipation: f64,
     /// Work of the normal load in this step, `P Δδn` (J/m).
     pub normal_work: f64,
-    /// Work of the electric load in this step, `φ̄0 ΔΓ` (J/m; zero under charge control).
+    /// Work of the electric load in this step, `−φ̄0 ΔΓ` (J/m; zero under a constant charge).
+    /// The electrode's free charge on the surface is `ω = −g`: Gauss's law across the surface
+    /// (the solid at z > 0, outward normal −z, no displacement in the conductor) gives
+    /// `ω = 0 − D·(−ẑ) = Dz(x, 0⁺) = −g`, so `∫ω = −Γ`, and the source that holds φ0 does
+    /// `φ0 d∫ω`. Over a closed cycle the works of Q, P and the electric load add up to the
+    /// dissipation.
     pub electric_work: f64,
     /// The solver that took the step.
     pub solver: SolverKind,
