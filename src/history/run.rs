@@ -132,6 +132,13 @@ pub fn continue_run(
     records: &mut Vec<StepRecord>,
 ) -> Option<StepFailure> {
     let turning = turning_points(current_load(state), points);
+    // The first step that changes P or the electric load of the spectral solver's state (its
+    // loads never change, and that step drops it): where a spectral stretch must end.
+    let first_move = state.driver.as_ref().and_then(|driver| {
+        points
+            .iter()
+            .position(|&p| moves_the_punch_from(model, driver, p))
+    });
     let mut next = 0;
     let mut recall = Recall::new(options.slip.accelerations.general_recall);
     if options.solver == SolverChoice::General
@@ -180,10 +187,7 @@ pub fn continue_run(
             (None, None) => unreachable!("a run state holds a driver or a general run"),
             (None, Some(driver)) => {
                 // The spectral stretch ends before the first step that moves the punch.
-                let end = points[next..]
-                    .iter()
-                    .position(|&p| moves_the_punch_from(model, driver, p))
-                    .map_or(points.len(), |k| next + k);
+                let end = first_move.unwrap_or(points.len());
                 let stretch = spectral_stretch(
                     model,
                     disc,
