@@ -94,6 +94,17 @@
 //! iterations, by the primal active-set method, which decreases J monotonically and
 //! terminates.
 //!
+//! **Prescribed displacement** ([`Drive::Displacement`]). When δx is given instead of Q, the
+//! multiplier Δδx is known and moves into the linear term, and the equality goes:
+//!
+//! ```text
+//! J(q) = ½ qᵀK q + (c − Δδx w)ᵀq   subject to   −ηp_i ≤ q_i ≤ ηp_i,
+//! ```
+//!
+//! with the same KKT conditions (Coulomb's law, slip `(∂J/∂q_i)/w_i`) and Q = Σ w_i q_i a
+//! result. The box alone always has a minimiser, also with every element at its bound: gross
+//! slip, Q = ±ηP, where the displacement exceeds what the stick zone can hold.
+//!
 //! # Alternation
 //! When q changes p or g (`w12 ≠ 0`, or `w13 ≠ 0` under a conducting punch, and full
 //! coupling), the two subproblems alternate until p and q change by less than
@@ -203,6 +214,17 @@ pub struct Loads {
     /// Γ (C/m) for [`Electrode::ConductingCharge`], φ0 (V) for
     /// [`Electrode::ConductingPotential`], unused otherwise.
     pub electric: f64,
+}
+
+/// How the tangential loading of a step is prescribed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Drive {
+    /// The tangential load Q of the step's [`Loads`]; δx is a result.
+    Load,
+    /// The rigid tangential displacement δx of the punch (m, datum d); Q is a result (the
+    /// step's `Loads::tangential` is ignored and the new state's is `∫q`). It reaches ±ηP
+    /// when every contact element slips one way: gross slip, a state like any other.
+    Displacement(f64),
 }
 
 /// Options of a step.
@@ -454,11 +476,23 @@ impl Solver {
         contact
     }
 
-    /// One load step from `previous` (its tractions and displacements are the slip reference).
+    /// One load step from `previous` (its tractions and displacements are the slip reference)
+    /// under the tangential load `loads.tangential`.
     pub fn step(
         &self,
         previous: &GeneralState,
         loads: Loads,
+    ) -> Result<(GeneralState, StepReport), SolveFailure> {
+        self.step_with(previous, loads, Drive::Load)
+    }
+
+    /// One step from `previous` to the normal and electric `loads` with the tangential
+    /// loading prescribed by `drive`.
+    pub fn step_with(
+        &self,
+        previous: &GeneralState,
+        loads: Loads,
+        drive: Drive,
     ) -> Result<(GeneralState, StepReport), SolveFailure> {
         assert_eq!(
             previous.mesh, self.mesh,
@@ -490,10 +524,18 @@ impl Solver {
             let normal = normal::solve(&input, contact, &mut work)?;
             let p_start = p_old.clone();
             contact = normal.contact.clone();
+            let total = match drive {
+                Drive::Load => Some(loads.tangential),
+                Drive::Displacement(_) => None,
+            };
+            let shift = match drive {
+                Drive::Load => 0.0,
+                Drive::Displacement(at) => at - previous.shift,
+            };
             let (q_new, tangential) = self.tangential(
                 previous,
                 &normal,
-                loads.tangential,
+                (total, shift),
                 (&q, &p_start),
                 &mut work,
             )?;
@@ -521,6 +563,10 @@ impl Solver {
             q = q_new;
             p_old.clone_from(&normal.pressure);
             if !alternate || (outer > 0 && change < self.options.tolerance) {
+                let mut loads = loads;
+                if total.is_none() {
+                    loads.tangential = (0..q.len()).map(|i| q[i] * self.mesh.width(i)).sum();
+                }
                 return Ok((self.finish(previous, loads, normal, q, tangential), report));
             }
         }
@@ -561,12 +607,14 @@ impl Solver {
     }
 
     /// The tangential subproblem at the pressure and charge of `normal`, with the previous
-    /// state's displacement as the slip reference, started from `start`.
+    /// state's displacement as the slip reference, started from `start`, under the load Q
+    /// (`total`) or, where that is `None`, the punch displacement increment `shift` (module
+    /// docs: the multiplier of the equality, prescribed, moves into the linear term).
     fn tangential(
         &self,
         previous: &GeneralState,
         normal: &NormalSolution,
-        total: f64,
+        (total, shift): (Option<f64>, f64),
         (start, start_pressure): (&[f64], &[f64]),
         work: &mut Workspace,
     ) -> Result<(Vec<f64>, Tangential), SolveFailure> {
@@ -584,11 +632,12 @@ impl Solver {
             iterations: 0,
         };
         if c.friction == 0.0 {
-            if total != 0.0 {
+            if let Some(total) = total.filter(|&t| t != 0.0) {
                 return Err(SolveFailure::NoAdmissibleState {
                     reason: format!("gross slip: Q = {total:.6e} N/m on a frictionless contact"),
                 });
             }
+            out.shift = shift;
             return Ok((q, out));
         }
         let fixed = self.fixed_displacement(&normal.pressure, &normal.charge);
@@ -603,7 +652,7 @@ impl Solver {
         let lin: Vec<f64> = act
             .iter()
             .zip(&w)
-            .map(|(&i, w)| fixed[i] - previous.displacement[i] * w)
+            .map(|(&i, w)| fixed[i] - (previous.displacement[i] + shift) * w)
             .collect();
         let bound: Vec<f64> = act
             .iter()
@@ -644,7 +693,7 @@ impl Solver {
             out.slip[i] = m.slip[r];
             out.status[i] = Some(m.status[r]);
         }
-        out.shift = m.shift;
+        out.shift = m.shift + shift;
         out.tolerance = m.slip_tolerance;
         out.iterations = m.iterations;
         Ok((q, out))

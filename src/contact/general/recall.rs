@@ -22,7 +22,7 @@
 use std::collections::VecDeque;
 use std::sync::Arc;
 
-use super::{GeneralState, Loads, Mesh, Options, Solver, StepReport};
+use super::{Drive, GeneralState, Loads, Mesh, Options, Solver, StepReport};
 use crate::contact::ContactModel;
 use crate::error::SolveFailure;
 
@@ -38,6 +38,7 @@ struct Step {
     solver: Arc<Solver>,
     from: GeneralState,
     loads: Loads,
+    drive: Drive,
     result: (GeneralState, StepReport),
 }
 
@@ -113,12 +114,24 @@ impl Recall {
         from: &GeneralState,
         loads: Loads,
     ) -> Result<(GeneralState, StepReport), SolveFailure> {
+        self.step_with(solver, from, loads, Drive::Load)
+    }
+
+    /// `solver.step_with(from, loads, drive)`, or the remembered result of the same step.
+    pub fn step_with(
+        &mut self,
+        solver: &Arc<Solver>,
+        from: &GeneralState,
+        loads: Loads,
+        drive: Drive,
+    ) -> Result<(GeneralState, StepReport), SolveFailure> {
         if !self.enabled {
-            return solver.step(from, loads);
+            return solver.step_with(from, loads, drive);
         }
         let found = self.steps.iter().position(|s| {
             Arc::ptr_eq(&s.solver, solver)
                 && same_loads(s.loads, loads)
+                && same_drive(s.drive, drive)
                 && same_state(&s.from, from)
         });
         if let Some(k) = found {
@@ -128,11 +141,12 @@ impl Recall {
             self.steps.push_front(step);
             return Ok(result);
         }
-        let result = solver.step(from, loads)?;
+        let result = solver.step_with(from, loads, drive)?;
         self.steps.push_front(Step {
             solver: Arc::clone(solver),
             from: from.clone(),
             loads,
+            drive,
             result: result.clone(),
         });
         self.steps.truncate(STEPS);
@@ -149,6 +163,14 @@ fn same_loads(a: Loads, b: Loads) -> bool {
         &[a.normal, a.tangential, a.electric],
         &[b.normal, b.tangential, b.electric],
     )
+}
+
+fn same_drive(a: Drive, b: Drive) -> bool {
+    match (a, b) {
+        (Drive::Load, Drive::Load) => true,
+        (Drive::Displacement(x), Drive::Displacement(y)) => x.to_bits() == y.to_bits(),
+        _ => false,
+    }
 }
 
 /// Equal to the bit (a derived `==` would take −0.0 for 0.0).

@@ -12,8 +12,11 @@ use super::normal::not_definite;
 
 use crate::error::SolveFailure;
 
-/// The programme `min ½ qᵀK q + cᵀq` subject to `−u ≤ q ≤ u` and `wᵀq = Q`, on the contact
-/// elements.
+/// The programme `min ½ qᵀK q + cᵀq` subject to `−u ≤ q ≤ u` and, under a prescribed
+/// tangential load, `wᵀq = Q`, on the contact elements. Under a prescribed displacement of the
+/// punch the equality is absent and c carries the displacement (`c − Δδx w`): the programme
+/// is then box-constrained only, and has a minimiser with every element at a bound (gross
+/// slip).
 pub(super) struct Programme<'a> {
     /// `K` (symmetric positive definite), contact elements only.
     pub k: &'a Mat<f64>,
@@ -23,8 +26,8 @@ pub(super) struct Programme<'a> {
     pub w: &'a [f64],
     /// `u = η p ≥ 0`.
     pub bound: &'a [f64],
-    /// Q (N/m).
-    pub total: f64,
+    /// Q (N/m) under a prescribed tangential load; `None` under a prescribed displacement.
+    pub total: Option<f64>,
     /// The mesh indices of the contact elements.
     pub elements: &'a [usize],
     /// `K` over the whole mesh (`K = kernel` on `elements`), for the factors of its free
@@ -44,7 +47,8 @@ pub(super) enum Bound {
 #[derive(Debug, Clone)]
 pub(super) struct Minimiser {
     pub q: Vec<f64>,
-    /// Multiplier of `wᵀq = Q`: the rigid tangential displacement increment of the punch (m).
+    /// Multiplier of `wᵀq = Q`: the rigid tangential displacement increment of the punch (m);
+    /// 0 without the equality.
     pub shift: f64,
     /// Mean incremental slip per element, `(1/w)(∂J/∂q) − shift` (zero on free elements).
     pub slip: Vec<f64>,
@@ -62,7 +66,10 @@ fn feasible_start(p: &Programme, start: &[f64]) -> Result<Vec<f64>, SolveFailure
         .zip(p.bound)
         .map(|(q, u)| q.clamp(-u, *u))
         .collect();
-    let excess = p.total - q.iter().zip(p.w).map(|(q, w)| q * w).sum::<f64>();
+    let Some(total) = p.total else {
+        return Ok(q);
+    };
+    let excess = total - q.iter().zip(p.w).map(|(q, w)| q * w).sum::<f64>();
     if excess == 0.0 {
         return Ok(q);
     }
@@ -77,7 +84,7 @@ fn feasible_start(p: &Programme, start: &[f64]) -> Result<Vec<f64>, SolveFailure
         return Err(SolveFailure::NoAdmissibleState {
             reason: format!(
                 "gross slip: |Q| = {:.6e} N/m ≥ ηP = {limit:.6e} N/m",
-                p.total.abs()
+                total.abs()
             ),
         });
     }
@@ -102,9 +109,10 @@ fn status_of(q: &[f64], bound: &[f64]) -> Vec<Bound> {
         .collect()
 }
 
-/// The equality-constrained step on the free set: `[K_FF −w_F; w_Fᵀ 0](d; λ) = (−∇_F; 0)`,
-/// by the factor of `K_FF`: `d = λ K_FF⁻¹w_F − K_FF⁻¹∇_F` with
-/// `λ = w_Fᵀ K_FF⁻¹∇_F / w_Fᵀ K_FF⁻¹w_F`.
+/// The step on the free set to the minimiser there: with the equality,
+/// `[K_FF −w_F; w_Fᵀ 0](d; λ) = (−∇_F; 0)`, by the factor of `K_FF`:
+/// `d = λ K_FF⁻¹w_F − K_FF⁻¹∇_F` with `λ = w_Fᵀ K_FF⁻¹∇_F / w_Fᵀ K_FF⁻¹w_F`; without it
+/// (a prescribed displacement), `d = −K_FF⁻¹∇_F` and λ = 0.
 fn free_step(
     p: &Programme,
     free: &[usize],
@@ -121,10 +129,14 @@ fn free_step(
         w[i] = p.w[r];
     }
     let [kg, kw] = factor.solve([&b, &w]);
-    let (wkg, wkw) = set.iter().fold((0.0, 0.0), |(a, b), &i| {
-        (a + w[i] * kg[i], b + w[i] * kw[i])
-    });
-    let shift = wkg / wkw;
+    let shift = if p.total.is_some() {
+        let (wkg, wkw) = set.iter().fold((0.0, 0.0), |(a, b), &i| {
+            (a + w[i] * kg[i], b + w[i] * kw[i])
+        });
+        wkg / wkw
+    } else {
+        0.0
+    };
     let d: Vec<f64> = set.iter().map(|&i| shift * kw[i] - kg[i]).collect();
     if !(shift.is_finite() && d.iter().all(|x| x.is_finite())) {
         return Err(SolveFailure::NonFinite {
@@ -166,7 +178,8 @@ pub(super) fn minimise(
 /// Primal–dual active set (Hintermüller, Ito & Kunisch 2003): fix the bound elements at their
 /// bounds, solve for the free ones with zero slip; a free element beyond its bound joins that
 /// bound, a bound element whose slip contradicts its friction is released; stop when nothing
-/// changes. `None` if it has not settled in 30 iterations or the free set empties.
+/// changes. `None` if it has not settled in 30 iterations, or if the free set empties under a
+/// prescribed load (the equality then has no free element to hold it).
 fn primal_dual(
     p: &Programme,
     start: &[Bound],
@@ -177,7 +190,7 @@ fn primal_dual(
     let mut status = start.to_vec();
     for iteration in 1..=30 {
         let free: Vec<usize> = (0..n).filter(|&i| status[i] == Bound::Free).collect();
-        if free.is_empty() {
+        if free.is_empty() && p.total.is_some() {
             return Ok(None);
         }
         let mut q: Vec<f64> = (0..n)
@@ -187,15 +200,21 @@ fn primal_dual(
                 Bound::Free => 0.0,
             })
             .collect();
-        // Make the equality hold through the free elements: Q − (bound part) on them.
-        let bound_part: f64 = q.iter().zip(p.w).map(|(q, w)| q * w).sum();
-        let wf: f64 = free.iter().map(|&i| p.w[i] * p.w[i]).sum();
-        // A particular free traction meeting the equality, then the free step from it.
-        let t = (p.total - bound_part) / wf;
-        for &i in &free {
-            q[i] = t * p.w[i];
+        // A particular free traction meeting the equality (Q − the bound part on the free
+        // elements), then the free step from it.
+        if let Some(total) = p.total {
+            let bound_part: f64 = q.iter().zip(p.w).map(|(q, w)| q * w).sum();
+            let wf: f64 = free.iter().map(|&i| p.w[i] * p.w[i]).sum();
+            let t = (total - bound_part) / wf;
+            for &i in &free {
+                q[i] = t * p.w[i];
+            }
         }
-        let (d, shift) = free_step(p, &free, &gradient(p, &q), work)?;
+        let (d, shift) = if free.is_empty() {
+            (Vec::new(), 0.0)
+        } else {
+            free_step(p, &free, &gradient(p, &q), work)?
+        };
         for (k, &i) in free.iter().enumerate() {
             q[i] += d[k];
         }
@@ -251,7 +270,11 @@ fn primal(
         let mut grad = gradient(p, &q);
         let free: Vec<usize> = (0..n).filter(|&i| status[i] == Bound::Free).collect();
         let shift = if free.is_empty() {
-            shift_without_free(p, &grad, &status)
+            if p.total.is_some() {
+                shift_without_free(p, &grad, &status)
+            } else {
+                0.0
+            }
         } else {
             let (d, shift) = free_step(p, &free, &grad, work)?;
             let mut alpha = 1.0;
@@ -372,7 +395,7 @@ mod tests {
             c: &c,
             w: &w,
             bound: &bound,
-            total: 0.1,
+            total: Some(0.1),
             elements: &elements,
             kernel: Kernel {
                 log: &inf.log,
