@@ -284,6 +284,8 @@ fn cycle(c: &mut Criterion) {
             punch: None,
             steps_per_segment: 10,
             max_step: 0.05 * lim,
+            control: fretsim::history::Control::Load,
+            max_displacement_step: f64::INFINITY,
         };
         g.bench_with_input(BenchmarkId::from_parameter(m), &m, |b, _| {
             b.iter(|| {

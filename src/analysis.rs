@@ -89,8 +89,10 @@ pub fn analyse_cycles(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>,
         let work = seg[1..].iter().map(|r| r.dissipation).sum();
         let normal_work = seg[1..].iter().map(|r| r.normal_work).sum();
         let electric_work = seg[1..].iter().map(|r| r.electric_work).sum();
+        // The last of equal minima: in gross slip Q stays at −ηP up to the reversal.
         let min = seg
             .iter()
+            .rev()
             .min_by(|a, b| a.q.total_cmp(&b.q))
             .expect("non-empty");
         let (hi_rec, lo_rec) = (&seg[seg.len() - 1], min);
@@ -165,8 +167,8 @@ impl OpenCycle {
         self.work += record.dissipation;
         self.normal_work += record.normal_work;
         self.electric_work += record.electric_work;
-        // The first of equal minima, as `Iterator::min_by`.
-        if record.q.total_cmp(&self.min.q) == std::cmp::Ordering::Less {
+        // The last of equal minima, as `analyse_cycles`.
+        if record.q.total_cmp(&self.min.q) != std::cmp::Ordering::Greater {
             self.min = record.clone();
         }
     }

@@ -33,14 +33,14 @@ use std::sync::Arc;
 use serde::{Deserialize, Serialize};
 
 use crate::contact::general::{
-    ElementState, Focus, GeneralState, Loads, Mesh, Options, Recall, Solver, StepReport,
+    Drive, ElementState, Focus, GeneralState, Loads, Mesh, Options, Recall, Solver, StepReport,
 };
 use crate::contact::tangential::{SlipOptions, StepAdmissibility};
 use crate::contact::{ContactModel, ContactState, Electrode};
 use crate::error::SolveFailure;
 
 use super::driver::DriverState;
-use super::load::{LoadPoint, PunchLoads};
+use super::load::{Control, LoadPoint, PunchLoads};
 use super::record::{StepFailure, StepRecord};
 use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
 
@@ -266,6 +266,9 @@ pub struct GeneralRun {
     /// (`numerics.general_element_size`).
     #[serde(default = "default_element_size")]
     element_size: f64,
+    /// What a load point's tangential value prescribes: Q, or the punch displacement δ.
+    #[serde(default, skip_serializing_if = "Control::is_load")]
+    pub control: Control,
 }
 
 fn default_element_size() -> f64 {
@@ -286,6 +289,8 @@ pub struct GeneralRunData {
     resume_at: usize,
     #[serde(default = "default_element_size")]
     element_size: f64,
+    #[serde(default)]
+    control: Control,
 }
 
 /// The loads of a state at tangential load `q`.
@@ -385,6 +390,7 @@ impl GeneralRun {
             works: [[0.0; 2]; 2],
             resume_at: 2,
             element_size: inner,
+            control: Control::Load,
         }
     }
 
@@ -404,6 +410,7 @@ impl GeneralRun {
             works: [[0.0; 2]; 2],
             resume_at: 2,
             element_size: inner,
+            control: Control::Load,
         }
     }
 
@@ -422,6 +429,7 @@ impl GeneralRun {
             works: data.works,
             resume_at: data.resume_at,
             element_size: data.element_size,
+            control: data.control,
         }
     }
 
@@ -471,7 +479,9 @@ impl GeneralRun {
 
     /// Take one load step and commit it (through `recall`); its record. A step whose normal or
     /// electric load differs from the state's is solved on a mesh made for its contact
-    /// ([`mesh_for_loads`]), the state carried onto it ([`Solver::transfer`]).
+    /// ([`mesh_for_loads`]), the state carried onto it ([`Solver::transfer`]). Under
+    /// [`Control::Displacement`] the point's value is δ, the regime that of Δδ, and Q a result
+    /// (gross slip, where no element sticks, is a state like any other).
     pub fn step(
         &mut self,
         model: &ContactModel,
@@ -488,10 +498,25 @@ impl GeneralRun {
         let moves = PunchLoads::of(loads.normal, loads.electric)
             != PunchLoads::of(old.loads.normal, old.loads.electric);
         let limit = model.friction * old.loads.normal.min(loads.normal);
-        let regime = next_regime(q - old.loads.tangential, 1e-12 * limit);
+        let (drive, regime) = match self.control {
+            Control::Load => (
+                Drive::Load,
+                next_regime(q - old.loads.tangential, 1e-12 * limit),
+            ),
+            Control::Displacement => {
+                let from = self.displacement();
+                let scale = q.abs().max(from.abs());
+                (
+                    Drive::Displacement(q - self.offset),
+                    next_regime(q - from, 1e-12 * scale),
+                )
+            }
+        };
         if regime.slip_sign().is_none() && !moves {
             let mut rec = self.record(step, t, regime, None);
-            rec.q = q;
+            if self.control == Control::Load {
+                rec.q = q;
+            }
             return Ok(rec);
         }
         // A failed step leaves the run as it was.
@@ -505,7 +530,7 @@ impl GeneralRun {
         };
         let old = carried.as_ref().unwrap_or(&self.state);
         let (new, report) = recall
-            .step(&solver, old, loads)
+            .step_with(&solver, old, loads, drive)
             .map_err(|failure| StepFailure {
                 step,
                 t,
@@ -513,7 +538,7 @@ impl GeneralRun {
                 regime,
                 failure,
             })?;
-        if new.length_of(ElementState::Stick) == 0.0 {
+        if self.control == Control::Load && new.length_of(ElementState::Stick) == 0.0 {
             return Err(StepFailure {
                 step,
                 t,

@@ -10,22 +10,54 @@
 //! loading (Q = 0, P and the electric load of the normal loading) to the first point, cut by
 //! the same rule, when the first point differs from it.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::error::Issue;
 
-/// A piecewise-linear load history: Q(t) in N/m, and optionally P(t) and the electric load.
+/// A piecewise-linear load history: Q(t) in N/m (or the punch displacement δ(t) in m, under
+/// [`Control::Displacement`]), and optionally P(t) and the electric load.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LoadHistory {
-    /// `(t, Q)` points, t strictly increasing (s, N/m).
+    /// `(t, Q)` points (`(t, δ)` under [`Control::Displacement`]), t strictly increasing
+    /// (s, N/m or m).
     pub points: Vec<(f64, f64)>,
+    /// What the second value of a point prescribes.
+    #[serde(skip_serializing_if = "Control::is_load")]
+    pub control: Control,
     /// The normal and electric loads at the same points, when the history prescribes them.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub punch: Option<PunchHistory>,
     /// Minimum number of steps per segment.
     pub steps_per_segment: usize,
-    /// Largest |ΔQ| (and η|ΔP|) of a step (N/m).
+    /// Largest |ΔQ| (and η|ΔP|) of a step (N/m); under [`Control::Displacement`] the largest
+    /// η|ΔP| (the bound on |Δδ| is [`LoadHistory::max_displacement_step`]).
     pub max_step: f64,
+    /// Largest |Δδ| of a step (m) under [`Control::Displacement`] (infinite: none).
+    #[serde(skip_serializing_if = "is_infinite")]
+    pub max_displacement_step: f64,
+}
+
+/// How the tangential loading of a history is prescribed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Control {
+    /// The tangential load Q(t); δ is a result.
+    #[default]
+    Load,
+    /// The punch's rigid tangential displacement δ(t), counted from the end of normal loading
+    /// (as the δ of the records); Q is a result, and reaches ±ηP in gross slip.
+    Displacement,
+}
+
+fn is_infinite(value: &f64) -> bool {
+    value.is_infinite()
+}
+
+impl Control {
+    /// Whether Q is prescribed.
+    pub fn is_load(&self) -> bool {
+        *self == Control::Load
+    }
 }
 
 /// P and the electric load along a [`LoadHistory`].
@@ -68,8 +100,12 @@ impl LoadHistory {
             _ => (0.0, 0.0),
         };
         let eta = self.punch.as_ref().map_or(0.0, |h| h.friction);
-        let change = (b.0 - a.0).abs().max(eta * dp.abs());
-        if change > 0.0 || dp != 0.0 {
+        let tangential = match self.control {
+            Control::Load => (b.0 - a.0).abs(),
+            Control::Displacement => (b.0 - a.0).abs() / self.max_displacement_step * self.max_step,
+        };
+        let change = tangential.max(eta * dp.abs());
+        if b.0 - a.0 != 0.0 || dp != 0.0 {
             self.steps_per_segment
                 .max((change / self.max_step).ceil() as usize)
                 .max(1)
@@ -122,9 +158,9 @@ impl LoadHistory {
     }
 
     /// Check the history before any solving: finite values, strictly increasing times, P > 0
-    /// where given, and `|Q| < ηP` at every point (a point at or beyond ηP is gross sliding;
-    /// both are linear along a segment, so the points suffice). `limit` is ηP of the normal
-    /// loading.
+    /// where given, and, where Q is prescribed, `|Q| < ηP` at every point (a point at or
+    /// beyond ηP is gross sliding, which only a prescribed displacement reaches; both are
+    /// linear along a segment, so the points suffice). `limit` is ηP of the normal loading.
     pub fn validate(&self, path: &str, limit: f64) -> Vec<Issue> {
         let mut issues = Vec::new();
         if self.points.is_empty() {
@@ -156,7 +192,14 @@ impl LoadHistory {
                 }
             }
             let limit = punch.map_or(limit, |(loads, eta)| eta * loads.normal);
-            if !q.is_finite() {
+            if self.control == Control::Displacement {
+                if !q.is_finite() {
+                    issues.push(Issue::new(
+                        format!("{path}.points[{i}].delta"),
+                        format!("{q} m is invalid; it must be finite"),
+                    ));
+                }
+            } else if !q.is_finite() {
                 issues.push(Issue::new(
                     format!("{path}.points[{i}].q"),
                     format!("{q} N/m is invalid; it must be finite"),
@@ -184,6 +227,17 @@ impl LoadHistory {
             issues.push(Issue::new(
                 format!("{path}.steps_per_segment"),
                 "0 is invalid; it must be ≥ 1",
+            ));
+        }
+        if self.control == Control::Displacement
+            && (self.max_displacement_step.is_nan() || self.max_displacement_step <= 0.0)
+        {
+            issues.push(Issue::new(
+                format!("{path}.max_step"),
+                format!(
+                    "{} m is invalid; it must be > 0",
+                    self.max_displacement_step
+                ),
             ));
         }
         if !(self.max_step.is_finite() && self.max_step > 0.0) {
@@ -297,6 +351,8 @@ mod tests {
         let h = LoadHistory {
             points: vec![(0.0, 0.0), (1.0, 500.0), (0.5, 700.0)],
             punch: None,
+            control: Control::Load,
+            max_displacement_step: f64::INFINITY,
             steps_per_segment: 4,
             max_step: 10.0,
         };
@@ -318,6 +374,8 @@ mod tests {
         let h = LoadHistory {
             points: vec![(0.0, 0.0), (1.0, 10.0), (2.0, 10.0), (3.0, -10.0)],
             punch: None,
+            control: Control::Load,
+            max_displacement_step: f64::INFINITY,
             steps_per_segment: 2,
             max_step: 4.0,
         };

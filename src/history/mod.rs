@@ -101,7 +101,7 @@ mod run;
 mod state;
 
 pub use general::{RunOptions, SolverChoice, SolverKind, ZoneCount};
-pub use load::{LoadHistory, LoadPoint, PunchHistory, PunchLoads};
+pub use load::{Control, LoadHistory, LoadPoint, PunchHistory, PunchLoads};
 pub use normal::{Loading, NormalEnd};
 pub use record::{NoObserver, Observer, SolvedState, StateView, StepFailure, StepRecord};
 pub use regime::Regime;

@@ -411,6 +411,8 @@ mod tests {
             punch: None,
             steps_per_segment: 10,
             max_step: 20.0,
+            control: crate::history::Control::Load,
+            max_displacement_step: f64::INFINITY,
         };
         let records = run_history(
             &sc.model,

@@ -12,7 +12,7 @@ use crate::error::SolveFailure;
 use super::driver::{DriverState, SolvedStep, Tried, finish_step, hold_record, try_step};
 use super::general::{GeneralRun, RunOptions, SolverChoice, SolverKind, ZoneCount};
 use super::increments::{IncrementInputs, StepIncrements};
-use super::load::{LoadHistory, LoadPoint, PunchLoads};
+use super::load::{Control, LoadHistory, LoadPoint, PunchLoads};
 use super::normal::NormalEnd;
 use super::record::{NoObserver, Observer, StateView, StepFailure, StepRecord};
 use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
@@ -52,7 +52,23 @@ pub fn run_history(
     let t0 = history.points.first().map_or(0.0, |p| p.0);
     let records = vec![normal.record(t0)];
     observer.on_step(&records[0], normal.view());
-    let state = normal.history_state();
+    let mut state = normal.history_state();
+    if history.control == Control::Displacement {
+        // The spectral solver prescribes Q: the general solver holds every step.
+        if let (None, Some(driver)) = (&state.general, &state.driver) {
+            let mut recall = Recall::new(options.slip.accelerations.general_recall);
+            state.general = Some(GeneralRun::handover(
+                model,
+                driver,
+                options.general_element_size,
+                &mut recall,
+            ));
+        }
+        state.driver = None;
+        if let Some(run) = state.general.as_mut() {
+            run.control = Control::Displacement;
+        }
+    }
     let points = history.load_points();
     run_from(model, disc, (state, records), &points, options, observer)
 }
@@ -296,9 +312,11 @@ fn moves_the_punch_from(model: &ContactModel, driver: &DriverState, point: LoadP
     })
 }
 
-/// The tangential load of the state's last step.
+/// The prescribed tangential value of the state's last step: Q, or δ under a prescribed
+/// displacement.
 fn current_load(state: &HistoryState) -> f64 {
     match &state.general {
+        Some(run) if run.control == Control::Displacement => run.displacement(),
         Some(run) => run.state.loads.tangential,
         None => {
             state

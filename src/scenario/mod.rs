@@ -209,6 +209,17 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
              \"auto\" or \"general\" (the spectral solver holds them fixed)",
         ));
     }
+    let displaced = history
+        .as_ref()
+        .and_then(|h| h.history.as_ref())
+        .is_some_and(|h| h.control == crate::history::Control::Displacement);
+    if displaced && raw.numerics.solver == crate::history::SolverChoice::Spectral {
+        issues.push(Issue::new(
+            "numerics.solver",
+            "\"spectral\" is invalid with a displacement history (`tangential_history.unit` = \
+             \"metre\"); it must be \"auto\" or \"general\" (the spectral solver prescribes Q)",
+        ));
+    }
     let span = history.as_ref().and_then(|h| h.span);
     let time_tolerance = validate_output(&mut issues, &raw.output, span, history.is_some());
     match (material, electrode, issues.is_empty()) {

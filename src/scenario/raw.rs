@@ -128,7 +128,8 @@ pub(super) fn default_field_points() -> usize {
     400
 }
 
-/// Unit of the tangential loads in a history.
+/// Unit of the tangential loads in a history, and with it what they prescribe: Q, or the
+/// punch's displacement δ (`metre`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum LoadUnit {
@@ -138,6 +139,9 @@ pub enum LoadUnit {
     FractionOfLimit,
     /// Q in N/m.
     NewtonPerMetre,
+    /// The punch's tangential displacement δ in m, counted from the end of normal loading
+    /// (displacement control: Q is a result and reaches ±ηP in gross slip); `max_step` in m.
+    Metre,
 }
 
 /// A piecewise-linear Q(t): `points` (lead-in, from Q = 0 at the end of normal loading),

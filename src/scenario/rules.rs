@@ -3,7 +3,7 @@
 
 use crate::contact::Electrode;
 use crate::error::Issue;
-use crate::history::{LoadHistory, PunchHistory, PunchLoads};
+use crate::history::{Control, LoadHistory, PunchHistory, PunchLoads};
 use crate::material::{IsotropicConstants, Material, preset};
 
 use super::*;
@@ -331,13 +331,35 @@ pub(super) fn resolve_history(
     let scale = match h.unit {
         LoadUnit::FractionOfLimit => limit,
         LoadUnit::NewtonPerMetre => 1.0,
+        LoadUnit::Metre => f64::NAN,
     };
-    // Q of a point in N/m: a fraction of η times the point's own P.
+    // Q of a point in N/m (a fraction of η times the point's own P), or δ in m.
     let q_of = |p: &[f64]| match h.unit {
         LoadUnit::FractionOfLimit => column(p, 1, 0.0) * (friction * column(p, 2, normal_load)),
-        LoadUnit::NewtonPerMetre => column(p, 1, 0.0),
+        LoadUnit::NewtonPerMetre | LoadUnit::Metre => column(p, 1, 0.0),
     };
-    let max_step = h.max_step.map_or(0.05 * limit, |m| m * scale);
+    // Under a prescribed displacement `max_step` bounds |Δδ| (m), and η|ΔP| keeps its default.
+    let (control, max_step, max_displacement_step) = match h.unit {
+        LoadUnit::Metre => (
+            Control::Displacement,
+            0.05 * limit,
+            h.max_step.unwrap_or(f64::INFINITY),
+        ),
+        _ => (
+            Control::Load,
+            h.max_step.map_or(0.05 * limit, |m| m * scale),
+            f64::INFINITY,
+        ),
+    };
+    // The tangential value of a point on the scale of `max_step`: Q (N/m), or δ in units of
+    // `max_displacement_step` times `max_step` (as `LoadHistory` counts steps).
+    let tangential_scale = match control {
+        Control::Load => 1.0,
+        Control::Displacement if max_displacement_step.is_finite() => {
+            max_step / max_displacement_step
+        }
+        Control::Displacement => 0.0,
+    };
     if friction <= 0.0 {
         issues.push(Issue::new(
             "tangential_history",
@@ -347,7 +369,12 @@ pub(super) fn resolve_history(
     let sized = limit.is_finite() && limit > 0.0 && h.steps_per_segment > 0;
     let steps = if sized && max_step.is_finite() && max_step > 0.0 {
         h.load_steps(
-            &|p| (q_of(p), friction * column(p, 2, normal_load)),
+            &|p| {
+                (
+                    q_of(p) * tangential_scale,
+                    friction * column(p, 2, normal_load),
+                )
+            },
             limit,
             max_step,
         )
@@ -406,6 +433,8 @@ pub(super) fn resolve_history(
         punch,
         steps_per_segment: h.steps_per_segment,
         max_step,
+        control,
+        max_displacement_step,
     };
     if friction > 0.0 && limit.is_finite() && limit > 0.0 && (2..=4).contains(&columns) {
         issues.extend(history.validate("tangential_history", limit));

@@ -476,6 +476,8 @@ mod history {
                 punch: None,
                 steps_per_segment: 1 + (next() * 12.0) as usize,
                 max_step: 0.02 + next() * 0.3,
+                control: crate::history::Control::Load,
+                max_displacement_step: f64::INFINITY,
             };
             let span = base.points.last().unwrap().0;
             let mut snaps: Vec<f64> = (0..(next() * 40.0) as usize)

@@ -86,6 +86,8 @@ fn run_points(
         punch: None,
         steps_per_segment,
         max_step,
+        control: fretsim::history::Control::Load,
+        max_displacement_step: f64::INFINITY,
     };
     run_history(
         model,
@@ -128,6 +130,8 @@ fn records_of(
         punch: None,
         steps_per_segment: 10,
         max_step: 0.05 * b.lim,
+        control: fretsim::history::Control::Load,
+        max_displacement_step: f64::INFINITY,
     };
     run_history(
         &b.model,
@@ -640,6 +644,8 @@ fn reference_cattaneo_mindlin_deresiewicz_masing() {
         punch: None,
         steps_per_segment: 8,
         max_step: 0.05 * lim,
+        control: fretsim::history::Control::Load,
+        max_displacement_step: f64::INFINITY,
     };
     for m in [32, 64, 128] {
         let disc = Discretisation::new(m);
@@ -1482,6 +1488,8 @@ fn pipelined_history_matches_sequential_steps() {
         punch: None,
         steps_per_segment: 3,
         max_step: 0.2 * b.lim,
+        control: fretsim::history::Control::Load,
+        max_displacement_step: f64::INFINITY,
     };
     let options = SlipOptions::default();
     let run = run_history(
@@ -1757,6 +1765,8 @@ fn repeated_steps_take_the_checks_and_increments_they_would_compute() {
             punch: None,
             steps_per_segment: 10,
             max_step: 0.05 * b.lim,
+            control: fretsim::history::Control::Load,
+            max_displacement_step: f64::INFINITY,
         };
         let mut driver = DriverState::after_normal_loading(&b.normal);
         let mut pairs = Vec::new();
@@ -1934,6 +1944,8 @@ fn batched_fields_equal_the_one_point_fields() {
         punch: None,
         steps_per_segment: 6,
         max_step: 0.1 * b.lim,
+        control: fretsim::history::Control::Load,
+        max_displacement_step: f64::INFINITY,
     };
     let mut states = States(Vec::new(), Vec::new());
     run_history(
@@ -2140,6 +2152,8 @@ fn a_recalled_step_from_another_start_computes_its_own_increments() {
         punch: None,
         steps_per_segment: 1,
         max_step: 0.15 * b.lim,
+        control: fretsim::history::Control::Load,
+        max_displacement_step: f64::INFINITY,
     };
     let mut recorder = Recorder::default();
     let run =
