@@ -468,7 +468,9 @@ fn general_step(c: &mut Criterion) {
 
 /// One cycle of P and Q in phase (`scenarios/normal_load_in_phase.json`, 40 steps, each on a
 /// mesh made for its contact), against the same cycle of Q at constant P taken by the general
-/// solver (40 steps on one mesh): the cost of a step that changes P.
+/// solver (40 steps on one mesh): the cost of a step that changes P; and one cycle of
+/// displacement control into gross slip (`scenarios/displacement_gross_slip.json`, 40
+/// steps, half of them on the Coulomb plateau).
 fn load_paths(c: &mut Criterion) {
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -483,9 +485,20 @@ fn load_paths(c: &mut Criterion) {
             r#""normal_load": 2240.0,"#,
             r#""normal_load": 2240.0, "numerics": {"solver": "general"},"#,
         );
+    let gross = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenarios/displacement_gross_slip.json"
+    ))
+    .unwrap()
+    .replace(r#""repeats": 3"#, r#""repeats": 1"#)
+    .replace(r#""steps_per_segment": 20"#, r#""steps_per_segment": 10"#);
     let mut g = c.benchmark_group("load_paths/cycle");
     g.sample_size(10);
-    for (name, text) in [("in_phase_p", in_phase), ("constant_p", constant)] {
+    for (name, text) in [
+        ("in_phase_p", in_phase),
+        ("constant_p", constant),
+        ("gross_slip", gross),
+    ] {
         let raw = fretsim::parse(&text, std::path::Path::new("bench.json")).unwrap();
         let sc = fretsim::validate(raw).unwrap();
         g.bench_function(BenchmarkId::from_parameter(name), |b| {

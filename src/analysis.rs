@@ -1,6 +1,7 @@
 //! The analysis of a tangential history's cycles: each cycle from a positive extreme of Q to
-//! the next, its loop area and friction work (the energy dissipated, computed two ways), and the
-//! verdict on whether the cycles settle. Pure computation on the step records; no I/O.
+//! the next, its loop area and friction work (the energy dissipated, computed two ways), its
+//! regime (partial, gross or no slip) and energy ratio `W/(4Q*δ*)`, and the verdict on
+//! whether the cycles settle. Pure computation on the step records; no I/O.
 
 use serde::Serialize;
 
@@ -35,6 +36,26 @@ pub struct CycleRow {
     pub change: Option<f64>,
     /// The cycle compared with.
     pub compared_with: Option<usize>,
+    /// Partial slip, gross slip or no slip ([`CycleRegime`]).
+    pub regime: CycleRegime,
+    /// The energy ratio of fretting maps, `W/(4Q*δ*)`: the friction work over the rectangle
+    /// of the loop's amplitudes `Q* = (Q_max − Q_min)/2` and `δ* = (δ_max − δ_min)/2` (below
+    /// about 0.2 partial slip, towards 1 gross slip); `None` for a loop without amplitude.
+    pub energy_ratio: Option<f64>,
+}
+
+/// What a cycle's contact did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CycleRegime {
+    /// Slip stopped: the friction work is below the verdict's tolerance (as the loop area is
+    /// for [`Verdict::Shakedown`]).
+    NoSlip,
+    /// Some point sticks at every step.
+    PartialSlip,
+    /// At some step no point sticks: the contact slides as a whole (only a prescribed
+    /// displacement reaches it).
+    GrossSlip,
 }
 
 /// Whether the cycles have settled.
@@ -89,13 +110,12 @@ pub fn analyse_cycles(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>,
         let work = seg[1..].iter().map(|r| r.dissipation).sum();
         let normal_work = seg[1..].iter().map(|r| r.normal_work).sum();
         let electric_work = seg[1..].iter().map(|r| r.electric_work).sum();
-        // The last of equal minima: in gross slip Q stays at −ηP up to the reversal.
         let min = seg
             .iter()
-            .rev()
-            .min_by(|a, b| a.q.total_cmp(&b.q))
+            .reduce(|m, r| if lower(r, m) { r } else { m })
             .expect("non-empty");
         let (hi_rec, lo_rec) = (&seg[seg.len() - 1], min);
+        let gross = seg[1..].iter().any(slides);
         let mut row = CycleRow {
             cycle: k + 1,
             steps: (seg[0].step, hi_rec.step),
@@ -109,12 +129,65 @@ pub fn analyse_cycles(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>,
             stick_at_min: (lo_rec.stick_lo, lo_rec.stick_hi),
             change: None,
             compared_with: None,
+            regime: partial_or_gross(gross),
+            energy_ratio: energy_ratio(work, (hi_rec, lo_rec)),
         };
         compare_with_earlier(&rows, &mut row, hi_rec.half_width, load_scale);
         rows.push(row);
     }
+    mark_no_slip(&mut rows, load_scale, tolerance);
     let verdict = judge(&rows, load_scale, tolerance);
     (rows, verdict)
+}
+
+/// Whether no point of the record's state sticks while some slips.
+fn slides(record: &StepRecord) -> bool {
+    record.zones.stick == 0 && record.zones.slip > 0
+}
+
+fn partial_or_gross(gross: bool) -> CycleRegime {
+    if gross {
+        CycleRegime::GrossSlip
+    } else {
+        CycleRegime::PartialSlip
+    }
+}
+
+/// `W/(4Q*δ*)` of a cycle with friction work `work` between its extremes (`CycleRow`).
+fn energy_ratio(work: f64, (hi, lo): (&StepRecord, &StepRecord)) -> Option<f64> {
+    let rectangle = (hi.q - lo.q) * (hi.displacement - lo.displacement);
+    (rectangle.abs() > 0.0).then(|| work / rectangle)
+}
+
+/// The cycles whose friction work is below the verdict's measure of no slip (the test of
+/// [`Verdict::Shakedown`] on the loop area: the two are the same energy over a closed cycle,
+/// and the friction work is also that of the last, open, cycle of a history).
+fn mark_no_slip(rows: &mut [CycleRow], load_scale: f64, tolerance: f64) {
+    for r in rows.iter_mut() {
+        let amp = (r.displacement_extremes.0 - r.displacement_extremes.1).abs();
+        if r.friction_work.abs() <= tolerance * amp * load_scale {
+            r.regime = CycleRegime::NoSlip;
+        }
+    }
+}
+
+/// Whether the cycle dissipates nothing within the tolerance: loop area at most `tolerance`
+/// times the δ range times the largest |Q| of the history.
+fn settled(r: &CycleRow, load_scale: f64, tolerance: f64) -> bool {
+    let amp = (r.displacement_extremes.0 - r.displacement_extremes.1).abs();
+    r.loop_area.abs() <= tolerance * amp * load_scale
+}
+
+/// Whether `record` is the cycle's negative extreme rather than `min`: its Q is lower, or
+/// equal to 1e−12 (a plateau at −ηP in gross slip, which carries the rounding of `∫q`) at a
+/// smaller δ (the displacement's turning point).
+fn lower(record: &StepRecord, min: &StepRecord) -> bool {
+    let tie = 1e-12 * record.q.abs().max(min.q.abs());
+    if (record.q - min.q).abs() <= tie {
+        record.displacement < min.displacement
+    } else {
+        record.q < min.q
+    }
 }
 
 /// [`analyse_cycles`] as the records arrive, holding the cycle under way and not the records:
@@ -145,6 +218,8 @@ struct OpenCycle {
     normal_work: f64,
     electric_work: f64,
     min: StepRecord,
+    /// Whether the contact slid as a whole at some step.
+    gross: bool,
 }
 
 impl OpenCycle {
@@ -158,6 +233,7 @@ impl OpenCycle {
             work: zero,
             normal_work: zero,
             electric_work: zero,
+            gross: false,
         }
     }
 
@@ -167,10 +243,10 @@ impl OpenCycle {
         self.work += record.dissipation;
         self.normal_work += record.normal_work;
         self.electric_work += record.electric_work;
-        // The last of equal minima, as `analyse_cycles`.
-        if record.q.total_cmp(&self.min.q) != std::cmp::Ordering::Greater {
+        if lower(record, &self.min) {
             self.min = record.clone();
         }
+        self.gross |= slides(record);
     }
 
     /// The row of the cycle ending at `last`, numbered `cycle`.
@@ -189,6 +265,8 @@ impl OpenCycle {
             stick_at_min: (lo_rec.stick_lo, lo_rec.stick_hi),
             change: None,
             compared_with: None,
+            regime: partial_or_gross(self.gross),
+            energy_ratio: energy_ratio(self.work, (hi_rec, lo_rec)),
         }
     }
 }
@@ -247,6 +325,7 @@ impl CycleAnalysis {
             compare_with_earlier(&rows, &mut row, half_width, self.load_scale);
             rows.push(row);
         }
+        mark_no_slip(&mut rows, self.load_scale, tolerance);
         let verdict = judge(&rows, self.load_scale, tolerance);
         (rows, verdict)
     }
@@ -286,10 +365,7 @@ fn compare_with_earlier(rows: &[CycleRow], row: &mut CycleRow, half_width: f64, 
 fn judge(rows: &[CycleRow], load_scale: f64, tolerance: f64) -> Verdict {
     if rows.is_empty() {
         Verdict::NoCycles
-    } else if let Some(r) = rows.iter().find(|r| {
-        let amp = (r.displacement_extremes.0 - r.displacement_extremes.1).abs();
-        r.loop_area.abs() <= tolerance * amp * load_scale
-    }) {
+    } else if let Some(r) = rows.iter().find(|r| settled(r, load_scale, tolerance)) {
         Verdict::Shakedown {
             from_cycle: r.cycle,
         }

@@ -100,15 +100,15 @@ impl LoadHistory {
             _ => (0.0, 0.0),
         };
         let eta = self.punch.as_ref().map_or(0.0, |h| h.friction);
-        let tangential = match self.control {
-            Control::Load => (b.0 - a.0).abs(),
-            Control::Displacement => (b.0 - a.0).abs() / self.max_displacement_step * self.max_step,
+        // Steps the change of Q (or δ) and of P need.
+        let needed = match self.control {
+            Control::Load => ((b.0 - a.0).abs().max(eta * dp.abs()) / self.max_step).ceil(),
+            Control::Displacement => ((b.0 - a.0).abs() / self.max_displacement_step)
+                .ceil()
+                .max((eta * dp.abs() / self.max_step).ceil()),
         };
-        let change = tangential.max(eta * dp.abs());
         if b.0 - a.0 != 0.0 || dp != 0.0 {
-            self.steps_per_segment
-                .max((change / self.max_step).ceil() as usize)
-                .max(1)
+            self.steps_per_segment.max(needed as usize).max(1)
         } else if de != 0.0 {
             self.steps_per_segment.max(1)
         } else {
@@ -367,6 +367,34 @@ mod tests {
         );
         assert!(issues[0].message.contains("|Q| < ηP"));
         assert!(issues[1].message.contains("must be > previous t = 1 s"));
+    }
+
+    /// Under a prescribed displacement a point's value is δ (m): any finite value (no ηP
+    /// rule: gross slip is a state), counted in steps by `max_displacement_step`.
+    #[test]
+    fn displacement_histories_name_delta_and_count_their_steps_in_metres() {
+        let mut h = LoadHistory {
+            points: vec![(0.0, 0.0), (1.0, 1e-6), (2.0, f64::NAN)],
+            punch: None,
+            control: Control::Displacement,
+            max_displacement_step: 1e-7,
+            steps_per_segment: 4,
+            max_step: 10.0,
+        };
+        let issues = h.validate("tangential_history", 600.0);
+        assert_eq!(issues.len(), 1);
+        assert_eq!(issues[0].path, "tangential_history.points[2].delta");
+        assert!(
+            issues[0]
+                .message
+                .contains("m is invalid; it must be finite")
+        );
+        h.points[2].1 = -4.95e-6;
+        assert!(h.validate("tangential_history", 600.0).is_empty());
+        // 1 µm in steps of at most 0.1 µm, then 5.95 µm: 10 and 60 steps.
+        assert_eq!((h.segment_steps(0), h.segment_steps(1)), (10, 60));
+        h.max_displacement_step = f64::INFINITY;
+        assert_eq!((h.segment_steps(0), h.segment_steps(1)), (4, 4));
     }
 
     #[test]

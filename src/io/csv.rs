@@ -181,19 +181,30 @@ pub fn cycles_table(cycles: &[CycleRow]) -> Table {
                 "compared_with_cycle",
                 Column::MaybeCount(c.iter().map(|c| c.compared_with).collect()),
             ),
+            (
+                "regime",
+                Column::Text(c.iter().map(|c| word(&c.regime)).collect()),
+            ),
+            (
+                "energy_ratio",
+                Column::MaybeReal(c.iter().map(|c| c.energy_ratio).collect()),
+            ),
         ],
     }
+}
+
+/// The word serde writes for a unit enum variant (`"forward_slip"`, `"gross_slip"`).
+fn word<T: serde::Serialize>(value: &T) -> String {
+    serde_json::to_value(value)
+        .ok()
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap_or_default()
 }
 
 /// `steps.csv`: one row per accepted step; `friction` is η.
 pub fn steps_table(records: &[StepRecord], friction: f64) -> Table {
     let r = records;
-    let regime = |r: &StepRecord| {
-        serde_json::to_value(r.regime)
-            .ok()
-            .and_then(|v| v.as_str().map(String::from))
-            .unwrap_or_default()
-    };
+    let regime = |r: &StepRecord| word(&r.regime);
     Table {
         columns: vec![
             ("step", Column::Count(r.iter().map(|r| r.step).collect())),

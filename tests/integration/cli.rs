@@ -64,6 +64,11 @@ struct LoadHistory {
     punch: Option<serde_json::Value>,
     steps_per_segment: usize,
     max_step: f64,
+    /// Present under displacement control only.
+    #[serde(default)]
+    control: Option<String>,
+    #[serde(default)]
+    max_displacement_step: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -90,6 +95,8 @@ struct Cycle {
     stick_at_min: (f64, f64),
     change: Option<f64>,
     compared_with: Option<usize>,
+    regime: String,
+    energy_ratio: Option<f64>,
 }
 
 #[derive(Debug, Deserialize, PartialEq)]
@@ -180,7 +187,7 @@ delta_m,dissipation_J_per_m,solver,stick_zones,slip_zones,slip_sign_changes";
 const CYCLES_HEADER: &str = "cycle,first_step,last_step,Q_start_N_per_m,Q_min_N_per_m,\
 Q_end_N_per_m,loop_area_J_per_m,friction_work_J_per_m,normal_work_J_per_m,electric_work_J_per_m,\
 delta_at_max_m,delta_at_min_m,stick_lo_at_max_m,stick_hi_at_max_m,stick_lo_at_min_m,\
-stick_hi_at_min_m,change_vs_previous,compared_with_cycle";
+stick_hi_at_min_m,change_vs_previous,compared_with_cycle,regime,energy_ratio";
 
 /// A CSV file's header and its data rows as numbers (non-numeric cells, such as the regime,
 /// become NaN).
@@ -406,10 +413,11 @@ fn run_scenario(name: &str) -> (tempfile::TempDir, PathBuf, Summary) {
 }
 
 /// The scenarios with a test of their own below; a file in `scenarios/` without one fails.
-const SCENARIOS: [&str; 15] = [
+const SCENARIOS: [&str; 16] = [
     "baseline",
     "charge_history",
     "cattaneo_mindlin_uncoupled",
+    "displacement_gross_slip",
     "figure3_history",
     "figure3_history_insulating",
     "figure4_aluminium",
@@ -535,6 +543,51 @@ fn scenario_normal_load_in_phase() {
         work[1] > 0.0 && (work[2] / work[1] - 1.0).abs() < 1e-2,
         "{work:?}"
     );
+}
+
+/// Displacement control into gross slip (`"unit": "metre"`): the general solver takes every
+/// step; δ in `steps.csv` is the prescribed one; Q reaches ±ηP and stays there while δ goes
+/// on (the Coulomb plateau, every element slipping); `cycles.csv` calls the cycles gross slip
+/// and gives their energy ratio; the slip loop is drawn.
+#[test]
+fn scenario_displacement_gross_slip() {
+    let (_tmp, out, s) = run_scenario("displacement_gross_slip");
+    assert_eq!(s.solver.general_steps, 240);
+    let (header, rows) = read_csv(&out.join("steps.csv"));
+    assert_eq!(rows.len(), 241);
+    let (t, ratio, delta, stick) = (
+        column(&header, &rows, "t_s"),
+        column(&header, &rows, "Q_over_etaP"),
+        column(&header, &rows, "delta_m"),
+        column(&header, &rows, "stick_zones"),
+    );
+    // δ(t) is the triangle wave of the file: 6e−8 m at t = 1, 0 at 2, −6e−8 m at 3, ….
+    let prescribed = |t: f64| {
+        let phase = t % 4.0;
+        6e-8 * match phase {
+            p if p <= 1.0 => p,
+            p if p <= 3.0 => 2.0 - p,
+            p => p - 4.0,
+        }
+    };
+    let mut plateau = 0;
+    for k in 0..rows.len() {
+        assert!((delta[k] - prescribed(t[k])).abs() < 1e-18, "step {k}");
+        assert!(ratio[k].abs() <= 1.0 + 1e-10, "step {k}");
+        if (ratio[k].abs() - 1.0).abs() < 1e-10 {
+            plateau += 1;
+            assert_eq!(stick[k], 0.0, "step {k} sticks on the plateau");
+        }
+    }
+    assert!(plateau > 100, "{plateau}");
+    let text = std::fs::read_to_string(out.join("cycles.csv")).unwrap();
+    let (ch, cycles) = read_csv(&out.join("cycles.csv"));
+    assert!(text.lines().skip(1).all(|l| l.contains(",gross_slip,")));
+    let energy = column(&ch, &cycles, "energy_ratio");
+    // The closed form, W_MD(ηP) + 4ηP(δ* − δ_g) over 4ηPδ*, is 0.5187 (test
+    // `displacement_control_into_gross_slip_follows_mindlin_deresiewicz_and_the_coulomb_plateau`).
+    assert!((energy[1] - 0.5187).abs() < 1e-3, "{energy:?}");
+    assert!(out.join("plots/hysteresis_slip.svg").is_file());
 }
 
 /// A charge history at constant P and Q on PZT-4 below Γ1 (`[t, Q, P, Γ]` points): the change

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use fretsim::analysis::Verdict;
+use fretsim::analysis::{CycleRegime, Verdict};
 use fretsim::history::StepRecord;
 
 fn scenario(json: &str) -> fretsim::Scenario {
@@ -199,6 +199,31 @@ fn history_columns_follow_their_rules() {
         r#""numerics": {"solver": "spectral"},"#,
     ));
     assert!(same.history.unwrap().punch.is_some());
+    // A displacement history (`"unit": "metre"`): δ may exceed anything (gross slip is a
+    // state); `max_step` (m) must be positive; the spectral solver, which prescribes Q, is
+    // refused.
+    let metre = |points: &str, extra: &str| {
+        with(conducting, points, extra).replace(r#""points""#, r#""unit": "metre", "points""#)
+    };
+    let displaced = scenario(&metre("[[0, 0], [1, 1e-3]]", ""));
+    let history = displaced.history.unwrap();
+    assert_eq!(history.control, fretsim::history::Control::Displacement);
+    let found = issues(&metre("[[0, 0], [1, 1e-7]]", "").replace(
+        r#""unit": "metre","#,
+        r#""unit": "metre", "max_step": -1e-9,"#,
+    ));
+    assert_eq!(found[0].path, "tangential_history.max_step");
+    assert!(found[0].message.contains("must be > 0"), "{}", found[0]);
+    let found = issues(&metre(
+        "[[0, 0], [1, 1e-7]]",
+        r#""numerics": {"solver": "spectral"},"#,
+    ));
+    assert_eq!(found[0].path, "numerics.solver");
+    assert!(
+        found[0].message.contains("displacement history"),
+        "{}",
+        found[0]
+    );
 }
 
 /// P and Q in phase about the state at P0 = 2240 N/m, Q = λ(P − P0), P from 1640 to 2840
@@ -242,17 +267,33 @@ fn in_phase_normal_and_tangential_loads_shake_down_below_the_friction_ratio_only
         let solved = solution(&json);
         let verdict = solved.summary.history.unwrap().verdict;
         let cycles = solved.cycles;
-        (cycles[0].friction_work, cycles[2].friction_work, verdict)
+        let regimes: Vec<CycleRegime> = cycles.iter().map(|c| c.regime).collect();
+        (
+            cycles[0].friction_work,
+            cycles[2].friction_work,
+            verdict,
+            regimes,
+        )
     };
-    let (first, third, verdict) = work(0.2);
+    let (first, third, verdict, regimes) = work(0.2);
     assert!(third / first < 1e-2, "λ = 0.2: {third:e} against {first:e}");
     assert!(
         matches!(verdict, Verdict::Shakedown { from_cycle: 2 }),
         "{verdict:?}"
     );
-    let (first, third, verdict) = work(0.5);
+    // The per-cycle regime says the same: slip in the first cycle, none from the second.
+    assert_eq!(regimes[0], CycleRegime::PartialSlip);
+    assert!(
+        regimes[1..].iter().all(|&r| r == CycleRegime::NoSlip),
+        "{regimes:?}"
+    );
+    let (first, third, verdict, regimes) = work(0.5);
     assert!(third / first > 0.3, "λ = 0.5: {third:e} against {first:e}");
     assert!(!matches!(verdict, Verdict::Shakedown { .. }), "{verdict:?}");
+    assert!(
+        regimes.iter().all(|&r| r == CycleRegime::PartialSlip),
+        "{regimes:?}"
+    );
 }
 
 /// A potential-controlled punch whose potential cycles between −20 and 20 V while Q cycles
@@ -433,5 +474,11 @@ fn displacement_control_into_gross_slip_follows_mindlin_deresiewicz_and_the_coul
     assert!(error < 5e-4, "{error}");
     assert!(solver_error < 5e-7, "{solver_error}");
     assert!((cycle.friction_work / cycle.loop_area - 1.0).abs() < 1e-12);
+    // The cycle slides as a whole at its extremes; its energy ratio W/(4Q*δ*), Q* = ηP.
+    assert_eq!(cycle.regime, CycleRegime::GrossSlip);
+    let ratio = exact / (4.0 * m.limit * delta_star);
+    let got = cycle.energy_ratio.expect("a loop with amplitude");
+    eprintln!("energy ratio {got:.6} against {ratio:.6}");
+    assert!((got / ratio - 1.0).abs() < 5e-4, "{got} against {ratio}");
     assert_eq!(cycle.displacement_extremes, (delta_star, -delta_star));
 }
