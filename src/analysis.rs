@@ -312,6 +312,44 @@ impl CycleAnalysis {
         self.rows.len()
     }
 
+    /// Whether the cycles closed so far have settled, by the rules of the verdict with the
+    /// largest |Q| so far as its scale: the last two cycles slip no more than the tolerance
+    /// (no slip: shakedown), or the cycles at the end each repeat the latest earlier cycle
+    /// under the same loads within the tolerance, over at least one period (the cycles from
+    /// the one the last cycle repeats to the last: one under constant amplitude, a block
+    /// under a repeated variable-amplitude block). A run may stop there
+    /// (`numerics.stop_when_settled`).
+    pub fn settled(&self, tolerance: f64) -> bool {
+        let (rows, scale) = (&self.rows, self.load_scale);
+        let n = rows.len();
+        let no_slip = |r: &CycleRow| {
+            let amp = (r.displacement_extremes.0 - r.displacement_extremes.1).abs();
+            r.friction_work.abs() <= tolerance * amp * scale
+        };
+        if n >= 2 && rows[n - 2..].iter().all(|(r, _)| no_slip(r)) {
+            return true;
+        }
+        let mut repeating = 0;
+        let mut period = 0;
+        for k in (0..n).rev() {
+            let (row, half_width) = &rows[k];
+            let Some(j) = (0..k)
+                .rev()
+                .find(|&j| same_loads(rows[j].0.loads, row.loads, scale))
+            else {
+                break;
+            };
+            if change_against(&rows[j].0, row, *half_width) > tolerance {
+                break;
+            }
+            if k + 1 == n {
+                period = k - j;
+            }
+            repeating += 1;
+        }
+        repeating > 0 && repeating >= period
+    }
+
     /// The rows and the verdict, the last record closing a cycle when it ends a forward phase.
     pub fn finish(mut self, tolerance: f64) -> (Vec<CycleRow>, Verdict) {
         if let Some(last) = self.previous.take()
@@ -336,28 +374,41 @@ impl CycleAnalysis {
 /// cycle one block earlier under a repeated variable-amplitude block. `half_width` is a at the
 /// cycle's positive extreme (the scale of the stick ends).
 fn compare_with_earlier(rows: &[CycleRow], row: &mut CycleRow, half_width: f64, load_scale: f64) {
-    let same = |a: (f64, f64, f64), b: (f64, f64, f64)| {
-        let tol = 1e-9 * load_scale;
-        (a.0 - b.0).abs() <= tol && (a.1 - b.1).abs() <= tol && (a.2 - b.2).abs() <= tol
-    };
-    if let Some(prev) = rows.iter().rev().find(|r| same(r.loads, row.loads)) {
-        let a = half_width;
-        let amp = (prev.displacement_extremes.0 - prev.displacement_extremes.1)
-            .abs()
-            .max(1e-300);
-        let energy = prev.loop_area.abs().max(1e-300);
-        let d = [
-            (row.stick_at_max.0 - prev.stick_at_max.0).abs() / a,
-            (row.stick_at_max.1 - prev.stick_at_max.1).abs() / a,
-            (row.stick_at_min.0 - prev.stick_at_min.0).abs() / a,
-            (row.stick_at_min.1 - prev.stick_at_min.1).abs() / a,
-            (row.displacement_extremes.0 - prev.displacement_extremes.0).abs() / amp,
-            (row.displacement_extremes.1 - prev.displacement_extremes.1).abs() / amp,
-            (row.loop_area - prev.loop_area).abs() / energy,
-        ];
-        row.change = Some(d.into_iter().fold(0.0, f64::max));
+    if let Some(prev) = rows
+        .iter()
+        .rev()
+        .find(|r| same_loads(r.loads, row.loads, load_scale))
+    {
+        row.change = Some(change_against(prev, row, half_width));
         row.compared_with = Some(prev.cycle);
     }
+}
+
+/// Whether two cycles have the same loads (start, minimum, end of Q) within 1e−9 of
+/// `load_scale`.
+fn same_loads(a: (f64, f64, f64), b: (f64, f64, f64), load_scale: f64) -> bool {
+    let tol = 1e-9 * load_scale;
+    (a.0 - b.0).abs() <= tol && (a.1 - b.1).abs() <= tol && (a.2 - b.2).abs() <= tol
+}
+
+/// The largest change of `row` against `prev`: stick ends relative to `half_width`, δ at the
+/// extremes relative to the δ range of `prev`, the loop area relative to that of `prev`.
+fn change_against(prev: &CycleRow, row: &CycleRow, half_width: f64) -> f64 {
+    let a = half_width;
+    let amp = (prev.displacement_extremes.0 - prev.displacement_extremes.1)
+        .abs()
+        .max(1e-300);
+    let energy = prev.loop_area.abs().max(1e-300);
+    let d = [
+        (row.stick_at_max.0 - prev.stick_at_max.0).abs() / a,
+        (row.stick_at_max.1 - prev.stick_at_max.1).abs() / a,
+        (row.stick_at_min.0 - prev.stick_at_min.0).abs() / a,
+        (row.stick_at_min.1 - prev.stick_at_min.1).abs() / a,
+        (row.displacement_extremes.0 - prev.displacement_extremes.0).abs() / amp,
+        (row.displacement_extremes.1 - prev.displacement_extremes.1).abs() / amp,
+        (row.loop_area - prev.loop_area).abs() / energy,
+    ];
+    d.into_iter().fold(0.0, f64::max)
 }
 
 /// The verdict on the cycles `rows` (compared, [`compare_with_earlier`]), with `load_scale`

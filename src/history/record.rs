@@ -193,6 +193,11 @@ pub trait Observer {
     /// ([`super::turning_points`]), with the state after it: everything the steps that
     /// follow need ([`super::HistoryState`]), to be written as a checkpoint.
     fn on_checkpoint(&mut self, _last: &StepRecord, _state: super::HistoryStateView<'_>) {}
+    /// Asked after [`Observer::on_checkpoint`] at each turning point: whether the run should
+    /// end there (the history's later steps are not taken; the run is complete, not failed).
+    fn stop(&self) -> bool {
+        false
+    }
 }
 
 /// An observer that does nothing.

@@ -137,7 +137,9 @@ pub fn turning_points(q: f64, points: &[LoadPoint]) -> Vec<bool> {
 /// from the last committed state ([`GeneralRun::handover`]), and so are the steps after it
 /// until the spectral solver can take one again (`resumes`); [`SolverChoice::General`]
 /// hands over at the first step. The driver is left at the last state the spectral solver
-/// committed, and the general solver's run in the state while it holds the steps.
+/// committed, and the general solver's run in the state while it holds the steps. The run
+/// ends early, complete, at a turning point where the observer asks it to
+/// ([`Observer::stop`]: the cycles have settled).
 pub fn continue_run(
     model: &ContactModel,
     disc: &Discretisation,
@@ -214,7 +216,7 @@ pub fn continue_run(
                     records,
                 );
                 let Some(stop) = stretch else {
-                    if end == points.len() {
+                    if end == points.len() || observer.stop() {
                         return None;
                     }
                     next = end;
@@ -277,6 +279,9 @@ pub fn continue_run(
         }
         if turning[next] {
             observer.on_checkpoint(records.last().expect("just pushed"), state.view());
+            if observer.stop() {
+                return None;
+            }
         }
         next += 1;
     }
@@ -496,6 +501,9 @@ fn spectral_stretch(
                     general: None,
                 };
                 observer.on_checkpoint(records.last().expect("just pushed"), view);
+                if observer.stop() {
+                    return None;
+                }
             }
         }
         finish(pending.take(), driver, records, observer);

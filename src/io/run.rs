@@ -121,6 +121,8 @@ pub(crate) struct Snapshots<'a> {
     error: Option<Error>,
     /// Checkpoints written by this process.
     written: usize,
+    /// Whether the run ended where its cycles had settled (`numerics.stop_when_settled`).
+    stopped: std::cell::Cell<bool>,
 }
 
 impl crate::history::Observer for Snapshots<'_> {
@@ -187,6 +189,15 @@ impl crate::history::Observer for Snapshots<'_> {
 
     fn on_phase(&mut self, phase: usize, memory: &crate::contact::memory::Memory) {
         self.inner.on_phase(phase, memory);
+    }
+
+    fn stop(&self) -> bool {
+        let numerics = &self.scenario.raw.numerics;
+        if numerics.stop_when_settled && self.digest.cycles.settled(numerics.cycle_tolerance) {
+            self.stopped.set(true);
+            return true;
+        }
+        self.inner.stop()
     }
 
     fn on_handover(&mut self, failure: &crate::history::StepFailure) {
@@ -409,6 +420,7 @@ pub(crate) fn solve_from<'a>(
         saved,
         error: None,
         written: 0,
+        stopped: std::cell::Cell::new(false),
     };
     if let Some(history) = &scenario.history {
         let options = RunOptions {
@@ -448,6 +460,7 @@ pub(crate) fn solve_from<'a>(
     if let Some(e) = snapshots.error.take() {
         return Err(e);
     }
+    let stopped_when_settled = snapshots.stopped.get();
     let kept = snapshots.kept;
     let records_held = snapshots.held;
     let mut digest = snapshots.digest;
@@ -464,7 +477,12 @@ pub(crate) fn solve_from<'a>(
     let history_summary = scenario
         .history
         .as_ref()
-        .map(|_| history_summary(&tally, failure.as_ref(), &cycles, verdict, tolerance));
+        .map(|_| {
+            let mut summary =
+                history_summary(&tally, failure.as_ref(), &cycles, verdict, tolerance);
+            summary.stopped_when_settled = stopped_when_settled;
+            summary
+        });
     // Sampled fields: the end of normal loading, then each snapshot time reached.
     let sample = |state: &SolvedState| -> Vec<SurfacePoint> {
         let (centre, half_width) = state.contact();

@@ -242,6 +242,9 @@ pub struct HistorySummary {
     pub verdict: Verdict,
     /// Tolerance of the verdict (relative).
     pub verdict_tolerance: f64,
+    /// Whether the run ended early, at the first turning point where the cycles had settled
+    /// (`numerics.stop_when_settled`).
+    pub stopped_when_settled: bool,
 }
 
 /// Inputs as the solver used them: a preset resolved to its constants, and the load history
@@ -574,6 +577,7 @@ pub(crate) fn history_summary(
         cycle_count: cycles.len(),
         verdict,
         verdict_tolerance: tolerance,
+        stopped_when_settled: false,
     }
 }
 

@@ -295,6 +295,11 @@ pub struct RawNumerics {
     /// the stick ends of the state it starts from.
     #[serde(default = "default_general_element_size")]
     pub general_element_size: f64,
+    /// End the run at the first turning point of the load where the cycles have settled
+    /// (shakedown, or steady cyclic slip over a whole period: `cycle_tolerance`), instead of
+    /// taking the rest of the history (default false).
+    #[serde(default)]
+    pub stop_when_settled: bool,
 }
 
 pub(super) fn default_general_element_size() -> f64 {
@@ -321,6 +326,7 @@ impl Default for RawNumerics {
             stick_end_kinks: default_stick_end_kinks(),
             solver: crate::history::SolverChoice::default(),
             general_element_size: default_general_element_size(),
+            stop_when_settled: false,
         }
     }
 }

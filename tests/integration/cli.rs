@@ -122,6 +122,7 @@ struct History {
     cycle_count: usize,
     verdict: Verdict,
     verdict_tolerance: f64,
+    stopped_when_settled: bool,
 }
 
 #[derive(Debug, Deserialize)]

@@ -482,3 +482,89 @@ fn displacement_control_into_gross_slip_follows_mindlin_deresiewicz_and_the_coul
     assert!((got / ratio - 1.0).abs() < 5e-4, "{got} against {ratio}");
     assert_eq!(cycle.displacement_extremes, (delta_star, -delta_star));
 }
+
+/// `numerics.stop_when_settled`: a run ends at the first turning point where its cycles have
+/// settled, with the verdict and the cycles of the whole run up to there. Under constant
+/// amplitude it stops once a cycle repeats the one before (the rows are those of the full run,
+/// to the bit); under a repeated variable-amplitude block only once a whole block repeats;
+/// P and Q in phase below the friction ratio (the shakedown above) once two cycles have not
+/// slipped.
+#[test]
+fn a_run_asked_to_stop_when_settled_ends_after_one_period_that_repeats() {
+    let file = |name: &str| {
+        std::fs::read_to_string(format!(
+            "{}/scenarios/{name}.json",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap()
+    };
+    let stopping = |json: &str| {
+        json.replacen(
+            r#""normal_load": 2240.0,"#,
+            r#""normal_load": 2240.0, "numerics": {"stop_when_settled": true, "cycle_tolerance": 1e-3},"#,
+            1,
+        )
+    };
+    let tolerant = |json: &str| {
+        json.replacen(
+            r#""normal_load": 2240.0,"#,
+            r#""normal_load": 2240.0, "numerics": {"cycle_tolerance": 1e-3},"#,
+            1,
+        )
+    };
+    let summary = |s: &fretsim::io::Solution| {
+        let h = s.summary.history.as_ref().unwrap();
+        (h.stopped_when_settled, h.verdict.clone())
+    };
+
+    // Constant amplitude: 10 cycles asked, the second repeats the first.
+    let many = file("many_cycles");
+    let full = solution(&tolerant(&many));
+    let stopped = solution(&stopping(&many));
+    let (stopped_early, verdict) = summary(&stopped);
+    assert!(stopped_early && !summary(&full).0);
+    assert!(
+        matches!(verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 }),
+        "{verdict:?}"
+    );
+    assert_eq!(stopped.cycles.len(), 2);
+    assert!(stopped.records.len() < full.records.len() / 3);
+    for (a, b) in stopped.cycles.iter().zip(&full.cycles) {
+        assert_eq!(
+            serde_json::to_string(a).unwrap(),
+            serde_json::to_string(b).unwrap()
+        );
+    }
+
+    // A block of two cycles (to ±0.2 and ±0.6 ηP): it stops only after both have repeated.
+    let block = file("variable_amplitude").replace(r#""repeats": 3"#, r#""repeats": 8"#);
+    let stopped = solution(&stopping(&block));
+    let (stopped_early, verdict) = summary(&stopped);
+    assert!(stopped_early);
+    assert!(
+        matches!(verdict, Verdict::SteadyCyclicSlip { .. }),
+        "{verdict:?}"
+    );
+    let n = stopped.cycles.len();
+    assert!(n < 16, "{n} cycles");
+    let tail = &stopped.cycles[n - 2..];
+    assert!(
+        tail.iter().all(|c| c.change.is_some_and(|x| x <= 1e-3)),
+        "{tail:?}"
+    );
+    assert_ne!(tail[0].loads, tail[1].loads);
+
+    // Shakedown: slip stops in the second cycle of eight.
+    let in_phase = file("normal_load_in_phase")
+        .replace(r#""repeats": 4"#, r#""repeats": 8"#)
+        .replace("300.0", "120.0")
+        .replace("-300.0", "-120.0");
+    let stopped = solution(&stopping(&in_phase));
+    let (stopped_early, verdict) = summary(&stopped);
+    assert!(stopped_early);
+    assert!(
+        matches!(verdict, Verdict::Shakedown { from_cycle: 2 }),
+        "{verdict:?}"
+    );
+    assert_eq!(stopped.cycles.len(), 3);
+}
