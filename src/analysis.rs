@@ -429,8 +429,9 @@ fn judge(rows: &[CycleRow], load_scale: f64, tolerance: f64) -> Verdict {
             .map(|i| rows[i - 1].cycle);
         match first_steady {
             Some(from_cycle) => Verdict::SteadyCyclicSlip { from_cycle },
+            // The last cycle compared (the history's last cycle may be open, and is not).
             None => Verdict::NotSettled {
-                last_change: rows.last().and_then(|r| r.change),
+                last_change: rows.iter().rev().find_map(|r| r.change),
             },
         }
     }

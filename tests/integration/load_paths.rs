@@ -296,6 +296,46 @@ fn in_phase_normal_and_tangential_loads_shake_down_below_the_friction_ratio_only
     );
 }
 
+/// The same in-phase loads at λ = 0.2 on a coupled contact, the elastic half-plane at
+/// ν = 0.3 (Dundurs' β = 0.29: the shear traction moves the pressure): it does not shake
+/// down. Melan's theorem is proved for frictional contact only without coupling between the
+/// tangential displacements and the normal tractions (β = 0; Barber, Klarbring and
+/// Ciavarella, C. R. Mécanique 336, 2008, with coupled counter-examples in Klarbring,
+/// Ciavarella and Barber 2007). Measured (10 steps a segment): the friction work of the
+/// third cycle is 0.43 of the first's (4.6e−3 on the uncoupled contact), and the cycles
+/// settle to a steady cyclic slip (change 4.7e−3 between the second and third cycles); the
+/// cycles are partial slip.
+#[test]
+fn a_coupled_contact_keeps_slipping_under_in_phase_loads_that_shake_the_uncoupled_one_down() {
+    let json = r#"{
+      "name": "in_phase_coupled",
+      "material": { "kind": "elastic", "shear_modulus": 27.3e9, "poisson_ratio": 0.3 },
+      "punch": { "radius": 0.01 },
+      "friction": 0.3,
+      "normal_load": 2240.0,
+      "numerics": { "cycle_tolerance": 1e-3 },
+      "tangential_history": {
+        "unit": "newton_per_metre",
+        "points": [[0.0, 0.0, 2240.0]],
+        "cycle": [[1.0, 120.0, 2840.0], [2.0, 0.0, 2240.0], [3.0, -120.0, 1640.0], [4.0, 0.0, 2240.0]],
+        "repeats": 4,
+        "steps_per_segment": 10
+      }
+    }"#;
+    let solved = solution(json);
+    let c = &solved.cycles;
+    let ratio = c[2].friction_work / c[0].friction_work;
+    eprintln!(
+        "coupled in phase: third/first friction work {ratio:.3}, change {:?}",
+        c[2].change
+    );
+    assert!(ratio > 0.3, "{ratio}");
+    assert!(c[2].change.is_some_and(|x| x < 1e-2));
+    assert!(c[..3].iter().all(|r| r.regime == CycleRegime::PartialSlip));
+    let verdict = solved.summary.history.unwrap().verdict;
+    assert!(!matches!(verdict, Verdict::Shakedown { .. }), "{verdict:?}");
+}
+
 /// A potential-controlled punch whose potential cycles between −20 and 20 V while Q cycles
 /// at constant P (PZT-4, η = 0.3): over a cycle that repeats, the works of Q (the loop
 /// area), of P and of the electric source add up to the frictional dissipation. The
