@@ -26,7 +26,15 @@
 //! default). The mesh stays while the normal and electric loads do: the state is the slip
 //! reference of the next step, and it belongs to its mesh. A step that changes either is
 //! solved on a mesh made for the contact before and after it ([`mesh_for_loads`]), with the
-//! state carried onto it ([`Solver::transfer`]).
+//! state carried onto it ([`Solver::transfer`]). A step to P = 0 lifts the punch off
+//! ([`Solver::separated`]: no contact, an undeformed surface); the step that presses it again
+//! is solved on a mesh made for the frictionless contact of its loads about x = 0.
+//!
+//! # Displacement control
+//! Under [`Control::Displacement`] a load point's tangential value is δ: the step prescribes
+//! δx = δ − (δ of the state − its δx) ([`crate::contact::general::Drive::Displacement`]),
+//! its regime is that of Δδ, Q is the result, and a state in which no element sticks (gross
+//! slip, Q = ±ηP) is accepted; under a prescribed Q it is an error (no quasi-static state).
 
 use std::sync::Arc;
 
@@ -337,9 +345,19 @@ pub fn mesh_for(state: &ContactState, inner: f64) -> Mesh {
 /// afresh at each change keeps the cost of a step bounded over a long history; the price is
 /// the ripple of carrying a state onto other edges ([`Solver::transfer`]).
 pub fn mesh_for_loads(solver: &Solver, state: &GeneralState, loads: Loads, inner: f64) -> Mesh {
-    let (lo, hi) = state.contact_extent().expect("a state in contact");
+    // A punch that left the half-plane comes back at x = 0 with its frictionless contact.
+    let (lo, hi, grown) = match state.contact_extent() {
+        Some((lo, hi)) => {
+            let a = 0.5 * (hi - lo);
+            let grown = a * solver.first_half_width(loads) / solver.first_half_width(state.loads);
+            (lo, hi, grown)
+        }
+        None => {
+            let a = solver.first_half_width(loads);
+            (-a, a, a)
+        }
+    };
     let (c, a) = (0.5 * (lo + hi), 0.5 * (hi - lo));
-    let grown = a * solver.first_half_width(loads) / solver.first_half_width(state.loads);
     let big = a.max(grown);
     let mut focus: Vec<Focus> = [c - a, c + a, c - grown, c + grown]
         .iter()
@@ -520,7 +538,8 @@ impl GeneralRun {
             return Ok(rec);
         }
         // A failed step leaves the run as it was.
-        let (solver, carried) = if moves {
+        let separates = loads.normal == 0.0;
+        let (solver, carried) = if moves && !separates {
             let mesh = mesh_for_loads(&self.solver, old, loads, self.element_size);
             let solver = recall.solver(model, mesh, Options::default());
             let carried = solver.transfer(old);
@@ -529,16 +548,27 @@ impl GeneralRun {
             (Arc::clone(&self.solver), None)
         };
         let old = carried.as_ref().unwrap_or(&self.state);
-        let (new, report) = recall
-            .step_with(&solver, old, loads, drive)
-            .map_err(|failure| StepFailure {
-                step,
-                t,
-                q,
-                regime,
-                failure,
-            })?;
-        if self.control == Control::Load && new.length_of(ElementState::Stick) == 0.0 {
+        let (new, report) = if separates {
+            let shift = match drive {
+                Drive::Load => old.shift,
+                Drive::Displacement(at) => at,
+            };
+            (solver.separated(loads, shift), StepReport::default())
+        } else {
+            recall
+                .step_with(&solver, old, loads, drive)
+                .map_err(|failure| StepFailure {
+                    step,
+                    t,
+                    q,
+                    regime,
+                    failure,
+                })?
+        };
+        if self.control == Control::Load
+            && new.contact_extent().is_some()
+            && new.length_of(ElementState::Stick) == 0.0
+        {
             return Err(StepFailure {
                 step,
                 t,

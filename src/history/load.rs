@@ -157,8 +157,9 @@ impl LoadHistory {
             .collect()
     }
 
-    /// Check the history before any solving: finite values, strictly increasing times, P > 0
-    /// where given, and, where Q is prescribed, `|Q| < ηP` at every point (a point at or
+    /// Check the history before any solving: finite values, strictly increasing times, P ≥ 0
+    /// where given (P = 0: the punch has left the half-plane, and Q must be 0), and, where Q is
+    /// prescribed, `|Q| < ηP` at every point (a point at or
     /// beyond ηP is gross sliding, which only a prescribed displacement reaches; both are
     /// linear along a segment, so the points suffice). `limit` is ηP of the normal loading.
     pub fn validate(&self, path: &str, limit: f64) -> Vec<Issue> {
@@ -178,10 +179,10 @@ impl LoadHistory {
             }
             let punch = self.punch.as_ref().map(|h| (h.points[i], h.friction));
             if let Some((loads, _)) = punch {
-                if !(loads.normal.is_finite() && loads.normal > 0.0) {
+                if !(loads.normal.is_finite() && loads.normal >= 0.0) {
                     issues.push(Issue::new(
                         format!("{path}.points[{i}].p"),
-                        format!("{} N/m is invalid; it must be finite and > 0", loads.normal),
+                        format!("{} N/m is invalid; it must be finite and ≥ 0", loads.normal),
                     ));
                 }
                 if !loads.electric.is_finite() {
@@ -204,6 +205,17 @@ impl LoadHistory {
                     format!("{path}.points[{i}].q"),
                     format!("{q} N/m is invalid; it must be finite"),
                 ));
+            } else if limit == 0.0 && punch.is_some() {
+                // Separation: no contact, so no tangential load.
+                if q != 0.0 {
+                    issues.push(Issue::new(
+                        format!("{path}.points[{i}].q"),
+                        format!(
+                            "{q} N/m is invalid at P = 0; it must be 0 (the punch has left the \
+                             half-plane)"
+                        ),
+                    ));
+                }
             } else if limit.is_finite() && q.abs() >= limit {
                 issues.push(Issue::new(
                     format!("{path}.points[{i}].q"),

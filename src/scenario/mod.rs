@@ -209,6 +209,25 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
              \"auto\" or \"general\" (the spectral solver holds them fixed)",
         ));
     }
+    // A punch off the half-plane (P = 0) carries no charge to it.
+    if let (Some(Electrode::ConductingCharge { .. }), Some(h)) =
+        (electrode, history.as_ref().and_then(|h| h.history.as_ref()))
+        && let Some(punch) = &h.punch
+        && let Some((k, loads)) = punch
+            .points
+            .iter()
+            .enumerate()
+            .find(|(_, l)| l.normal == 0.0 && l.electric != 0.0)
+    {
+        issues.push(Issue::new(
+            "tangential_history",
+            format!(
+                "Γ = {} C/m at P = 0 (t = {} s) is invalid; it must be 0 where P is (a punch \
+                 off the half-plane carries no charge to it)",
+                loads.electric, h.points[k].0
+            ),
+        ));
+    }
     let displaced = history
         .as_ref()
         .and_then(|h| h.history.as_ref())

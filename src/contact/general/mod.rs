@@ -250,7 +250,7 @@ impl Default for Options {
 }
 
 /// What a step did.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct StepReport {
     /// Outer (normal–tangential) iterations.
     pub outer_iterations: usize,
@@ -460,6 +460,24 @@ impl Solver {
             (&state.pressure, &state.charge, state.approach),
             &contact,
         )
+    }
+
+    /// The state of a punch that has left the half-plane (P = 0): no contact, no traction or
+    /// charge, and so an undeformed surface (`ux = 0`: the memory of the past is gone, and a
+    /// contact made again sticks where it forms); δz = 0 (the surface is at its datum), δx
+    /// `shift` (the punch may move while it is off), φ0 the prescribed potential of a
+    /// potential-controlled punch and 0 otherwise.
+    pub fn separated(&self, loads: Loads, shift: f64) -> GeneralState {
+        let mut state = GeneralState::unloaded(self.mesh.clone());
+        state.shift = shift;
+        if let ElectricControl::Potential(potential) = self.electric_control(loads) {
+            state.potential = potential;
+        }
+        state.loads = Loads {
+            tangential: 0.0,
+            ..loads
+        };
+        state
     }
 
     /// The contact elements of the start of a step: the previous contact, or the frictionless
