@@ -38,6 +38,11 @@ pub struct CycleRow {
     pub compared_with: Option<usize>,
     /// Partial slip, gross slip or no slip ([`CycleRegime`]).
     pub regime: CycleRegime,
+    /// The slip amplitude δ_s (m): half the range over the cycle of the slip displacement
+    /// `δ − C·Q`, with C the stuck compliance taken as `Δδ/ΔQ` of the cycle's first step (right
+    /// after its positive extreme every point sticks: C to first order in the step); `None`
+    /// when that step does not change Q.
+    pub slip_amplitude: Option<f64>,
     /// The energy ratio of fretting maps, `W/(4Q*δ*)`: the friction work over the rectangle
     /// of the loop's amplitudes `Q* = (Q_max − Q_min)/2` and `δ* = (δ_max − δ_min)/2` (below
     /// about 0.2 partial slip, towards 1 gross slip); `None` for a loop without amplitude.
@@ -116,6 +121,8 @@ pub fn analyse_cycles(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>,
             .expect("non-empty");
         let (hi_rec, lo_rec) = (&seg[seg.len() - 1], min);
         let gross = seg[1..].iter().any(slides);
+        let mut slip = SlipRange::default();
+        seg.iter().for_each(|r| slip.add(r));
         let mut row = CycleRow {
             cycle: k + 1,
             steps: (seg[0].step, hi_rec.step),
@@ -130,6 +137,7 @@ pub fn analyse_cycles(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>,
             change: None,
             compared_with: None,
             regime: partial_or_gross(gross),
+            slip_amplitude: slip.amplitude(),
             energy_ratio: energy_ratio(work, (hi_rec, lo_rec)),
         };
         compare_with_earlier(&rows, &mut row, hi_rec.half_width, load_scale);
@@ -138,6 +146,43 @@ pub fn analyse_cycles(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>,
     mark_no_slip(&mut rows, load_scale, tolerance);
     let verdict = judge(&rows, load_scale, tolerance);
     (rows, verdict)
+}
+
+/// The range of the slip displacement `δ − C·Q` over a cycle's records, taken in order
+/// (`CycleRow::slip_amplitude`): the first two give C.
+#[derive(Debug, Clone, Default)]
+struct SlipRange {
+    first: Option<(f64, f64)>,
+    compliance: Option<f64>,
+    range: Option<(f64, f64)>,
+}
+
+impl SlipRange {
+    fn add(&mut self, r: &StepRecord) {
+        let Some((q0, d0)) = self.first else {
+            self.first = Some((r.q, r.displacement));
+            return;
+        };
+        if self.compliance.is_none() {
+            if r.q - q0 == 0.0 {
+                return;
+            }
+            let c = (r.displacement - d0) / (r.q - q0);
+            self.compliance = Some(c);
+            let s0 = d0 - c * q0;
+            self.range = Some((s0, s0));
+        }
+        let c = self.compliance.expect("set above");
+        let s = r.displacement - c * r.q;
+        if let Some((lo, hi)) = self.range.as_mut() {
+            *lo = lo.min(s);
+            *hi = hi.max(s);
+        }
+    }
+
+    fn amplitude(&self) -> Option<f64> {
+        self.range.map(|(lo, hi)| 0.5 * (hi - lo))
+    }
 }
 
 /// Whether no point of the record's state sticks while some slips.
@@ -220,6 +265,8 @@ struct OpenCycle {
     min: StepRecord,
     /// Whether the contact slid as a whole at some step.
     gross: bool,
+    /// The range of the slip displacement.
+    slip: SlipRange,
 }
 
 impl OpenCycle {
@@ -234,7 +281,15 @@ impl OpenCycle {
             normal_work: zero,
             electric_work: zero,
             gross: false,
+            slip: SlipRange::default(),
         }
+        .starting_at()
+    }
+
+    /// The slip range begins at the first record.
+    fn starting_at(mut self) -> Self {
+        self.slip.add(&self.first);
+        self
     }
 
     /// Add the step from `previous` to `record`.
@@ -247,6 +302,7 @@ impl OpenCycle {
             self.min = record.clone();
         }
         self.gross |= slides(record);
+        self.slip.add(record);
     }
 
     /// The row of the cycle ending at `last`, numbered `cycle`.
@@ -266,6 +322,7 @@ impl OpenCycle {
             change: None,
             compared_with: None,
             regime: partial_or_gross(self.gross),
+            slip_amplitude: self.slip.amplitude(),
             energy_ratio: energy_ratio(self.work, (hi_rec, lo_rec)),
         }
     }

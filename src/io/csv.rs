@@ -186,6 +186,10 @@ pub fn cycles_table(cycles: &[CycleRow]) -> Table {
                 Column::Text(c.iter().map(|c| word(&c.regime)).collect()),
             ),
             (
+                "slip_amplitude_m",
+                Column::MaybeReal(c.iter().map(|c| c.slip_amplitude).collect()),
+            ),
+            (
                 "energy_ratio",
                 Column::MaybeReal(c.iter().map(|c| c.energy_ratio).collect()),
             ),

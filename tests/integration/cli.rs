@@ -96,6 +96,7 @@ struct Cycle {
     change: Option<f64>,
     compared_with: Option<usize>,
     regime: String,
+    slip_amplitude: Option<f64>,
     energy_ratio: Option<f64>,
 }
 
@@ -188,7 +189,7 @@ delta_m,dissipation_J_per_m,solver,stick_zones,slip_zones,slip_sign_changes";
 const CYCLES_HEADER: &str = "cycle,first_step,last_step,Q_start_N_per_m,Q_min_N_per_m,\
 Q_end_N_per_m,loop_area_J_per_m,friction_work_J_per_m,normal_work_J_per_m,electric_work_J_per_m,\
 delta_at_max_m,delta_at_min_m,stick_lo_at_max_m,stick_hi_at_max_m,stick_lo_at_min_m,\
-stick_hi_at_min_m,change_vs_previous,compared_with_cycle,regime,energy_ratio";
+stick_hi_at_min_m,change_vs_previous,compared_with_cycle,regime,slip_amplitude_m,energy_ratio";
 
 /// A CSV file's header and its data rows as numbers (non-numeric cells, such as the regime,
 /// become NaN).

@@ -456,7 +456,9 @@ impl Mindlin {
 /// 6e−3 a; 20 steps of 3 nm a segment): Q at every step within 5.1e−7 ηP of the closed form
 /// (117 steps on the plateau, there to 1e−12); the loop area of the second cycle within 3.0e−4
 /// of the closed form, which is the trapezoidal rule over 3 nm steps (the same rule on the
-/// closed form's Q at the steps: 1.5e−7); the friction work within 1.6e−15 of the loop area.
+/// closed form's Q at the steps: 1.5e−7); the friction work within 1.6e−15 of the loop area;
+/// the slip amplitude 3.2049e−8 m against δ* − CηP = 3.2103e−8 m (1.7e−3: C from the first
+/// step after the reversal).
 #[test]
 fn displacement_control_into_gross_slip_follows_mindlin_deresiewicz_and_the_coulomb_plateau() {
     let json = include_str!("../../scenarios/displacement_gross_slip.json");
@@ -534,6 +536,19 @@ fn displacement_control_into_gross_slip_follows_mindlin_deresiewicz_and_the_coul
     assert!(error < 5e-4, "{error}");
     assert!(solver_error < 5e-7, "{solver_error}");
     assert!((cycle.friction_work / cycle.loop_area - 1.0).abs() < 1e-12);
+    // The slip amplitude, half the range of δ − C·Q with C the stuck compliance: at the
+    // extremes of the plateau ±(δ* − CηP), with `C = dδ/dQ` at a reversal
+    // `= δ_l'(0) = (y11/π) ln(2d/a)` (Mindlin's δ_l differentiated at Q = 0). The cycle's C is
+    // the slope of its first step (first order in the step).
+    let a = m.exact.half_width;
+    let stuck = m.y11 / std::f64::consts::PI * (2.0 * m.d / a).ln();
+    let slip_exact = delta_star - stuck * m.limit;
+    let slip = cycle.slip_amplitude.expect("a cycle that moves Q");
+    eprintln!("slip amplitude {slip:.6e} m against {slip_exact:.6e} m");
+    assert!(
+        (slip / slip_exact - 1.0).abs() < 2.5e-3,
+        "{slip} against {slip_exact}"
+    );
     // The cycle slides as a whole at its extremes; its energy ratio W/(4Q*δ*), Q* = ηP.
     assert_eq!(cycle.regime, CycleRegime::GrossSlip);
     let ratio = exact / (4.0 * m.limit * delta_star);
