@@ -54,7 +54,10 @@
 //! start state takes that step's checks and φ0 (`Recalled::admissibility`): its states are
 //! the recalled step's to the tolerance.
 //! An attempt that stalls from a carried or coarse Jacobian is made once more from a
-//! finite-difference one before its stalled iterate is taken.
+//! finite-difference one before its stalled iterate is taken. Where another solver takes the
+//! steps this one fails (`numerics.solver = auto`), a step's attempts together make at most
+//! `SlipOptions::step_evaluations` residual evaluations: a step that fails would otherwise
+//! make its whole attempt plan, which grows with the stick ends the memory remembers.
 //! (Block Gauss–Seidel between the stick ends and (a, c), as in the seed paper, falls into
 //! 2-cycles when the contact shifts at a reversal.)
 //!
@@ -221,11 +224,11 @@ pub struct SlipOptions {
     /// step, Masing's return, the attempt plan, a retry from a fresh Jacobian, Newton's
     /// fallback), counted on the step's own grid as [`SlipStep::newton_iterations`] counts
     /// them (the coarse grid's Jacobians not counted); `None` (the default): no bound, every
-    /// attempt of the plan is made. Once the bound is reached the attempt under way stops at
-    /// its next iterate, unless that iterate has converged, and no further attempt is made,
-    /// except that at least one attempt of the plan is always made (the failure reported is
-    /// the first attempt's, as without the bound). Set where another solver takes the steps
-    /// this one fails ([`Self::STEP_EVALUATIONS_BEHIND_ANOTHER_SOLVER`]).
+    /// attempt of the plan is made. Once the bound is reached, the attempt under way stops at
+    /// its next iterate (unless that iterate has converged), and no further attempt is made
+    /// once one has failed: the failure reported is the first attempt's, as without the
+    /// bound. Set where another solver takes the steps this one fails
+    /// ([`Self::STEP_EVALUATIONS_BEHIND_ANOTHER_SOLVER`]).
     pub step_evaluations: Option<usize>,
     /// The speed-ups that carry information from one evaluation or step to the next
     /// ([`Accelerations`]; all on by default, [`Accelerations::none`] for the reference path).

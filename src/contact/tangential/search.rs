@@ -1,8 +1,8 @@
 //! The search for a step's geometry `(lo, hi, a, c)` (tangential module docs): the attempt
 //! plan of `solve_slip` (a recalled step, Masing's return to a remembered turning state, the
-//! stick-zone guesses and slip-sign patterns in turn, Newton's fallback), the quasi-Newton
-//! iteration of one attempt (`solve_geometry`) and its finite-difference and coarse-grid
-//! Jacobians.
+//! stick-zone guesses and slip-sign patterns in turn, Newton's fallback, within the step's
+//! bound on residual evaluations where one is set), the quasi-Newton iteration of one attempt
+//! (`solve_geometry`) and its finite-difference and coarse-grid Jacobians.
 
 use std::cell::{Cell, RefCell};
 use std::sync::Arc;
