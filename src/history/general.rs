@@ -106,6 +106,7 @@ impl RunOptions {
             SolverChoice::Auto => SlipOptions {
                 stall_tolerance: 0.0,
                 newton_fallback: false,
+                step_evaluations: Some(SlipOptions::STEP_EVALUATIONS_BEHIND_ANOTHER_SOLVER),
                 ..SlipOptions::default()
             },
             _ => SlipOptions::default(),

@@ -54,7 +54,10 @@
 //! start state takes that step's checks and φ0 (`Recalled::admissibility`): its states are
 //! the recalled step's to the tolerance.
 //! An attempt that stalls from a carried or coarse Jacobian is made once more from a
-//! finite-difference one before its stalled iterate is taken.
+//! finite-difference one before its stalled iterate is taken. Where another solver takes the
+//! steps this one fails (`numerics.solver = auto`), a step's attempts together make at most
+//! `SlipOptions::step_evaluations` residual evaluations: a step that fails would otherwise
+//! make its whole attempt plan, which grows with the stick ends the memory remembers.
 //! (Block Gauss–Seidel between the stick ends and (a, c), as in the seed paper, falls into
 //! 2-cycles when the contact shifts at a reversal.)
 //!
@@ -217,6 +220,16 @@ pub struct SlipOptions {
     /// another solver takes the steps this one fails (`numerics.solver = auto`): a step that
     /// fails both ways costs about twice the evaluations of its quasi-Newton attempts.
     pub newton_fallback: bool,
+    /// The most residual evaluations a step may make over all its attempts (the recalled
+    /// step, Masing's return, the attempt plan, a retry from a fresh Jacobian, Newton's
+    /// fallback), counted on the step's own grid as [`SlipStep::newton_iterations`] counts
+    /// them (the coarse grid's Jacobians not counted); `None` (the default): no bound, every
+    /// attempt of the plan is made. Once the bound is reached, the attempt under way stops at
+    /// its next iterate (unless that iterate has converged), and no further attempt is made
+    /// once one has failed: the failure reported is the first attempt's, as without the
+    /// bound. Set where another solver takes the steps this one fails
+    /// ([`Self::STEP_EVALUATIONS_BEHIND_ANOTHER_SOLVER`]).
+    pub step_evaluations: Option<usize>,
     /// The speed-ups that carry information from one evaluation or step to the next
     /// ([`Accelerations`]; all on by default, [`Accelerations::none`] for the reference path).
     pub accelerations: Accelerations,
@@ -231,9 +244,29 @@ impl Default for SlipOptions {
             admissibility: 1e-3,
             stall_tolerance: 1e-4,
             newton_fallback: true,
+            step_evaluations: None,
             accelerations: Accelerations::default(),
         }
     }
+}
+
+impl SlipOptions {
+    /// The bound on a step's residual evaluations ([`Self::step_evaluations`]) where the
+    /// general solver takes the steps this one fails (`numerics.solver = auto`).
+    ///
+    /// Chosen above every step that converged in the runs measured, and far below what the
+    /// steps that fail take on a long history. Over the scenario files (the 15 in `scenarios/`
+    /// and the default run: 781 steps and take-back tries) and five runs of
+    /// `docs/failure_map.md` (the one `auto` did not complete, its first 300 s, and four that
+    /// took 30–120 s: 2,299 more), 2,817 converged with at most 570 evaluations (median 4,
+    /// 99th percentile 214, 99.9th 462; the scenario files' at most 82), the largest after
+    /// seven or eight failed attempts. The 263 that failed took 202–10,509 (median 668),
+    /// 329,178 evaluations in all against 30,796 for the ones that converged; in the run that
+    /// did not complete, 32 failed steps took 540–10,509 each (up to 171 attempts: its memory
+    /// holds many stick ends, and the plan tries pairs of them), 280 s of its 300 s. A bound
+    /// of 600 keeps every converged step of those runs, so they take the same steps to the
+    /// bit; 500 would have handed two of them to the general solver, 300 seventeen.
+    pub const STEP_EVALUATIONS_BEHIND_ANOTHER_SOLVER: usize = 600;
 }
 
 /// Worst violations of the step's admissibility checks (≤ 0 when admissible).
@@ -469,6 +502,7 @@ mod tests {
             tangential_load: driver.state.tangential_load,
             scratch: maps,
             accelerations: Accelerations::default(),
+            evaluations: None,
         }
     }
 

@@ -6,7 +6,7 @@
 //! resultant, stick consistency and force) that the search drives to zero. With the inner
 //! iteration's tolerances.
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::sync::Arc;
 
 use crate::contact::memory::Memory;
@@ -70,6 +70,10 @@ pub(super) struct StepProblem<'a> {
     pub(super) scratch: &'a RefCell<InnerMaps>,
     /// The speed-ups in use (the accepted zones' tables).
     pub(super) accelerations: Accelerations,
+    /// The count of the step's residual evaluations on its own grid, over all its attempts,
+    /// which [`SlipOptions::step_evaluations`](super::SlipOptions::step_evaluations) bounds;
+    /// `None` where they are not counted (the coarse grid's, a test's problem).
+    pub(super) evaluations: Option<&'a Cell<usize>>,
 }
 
 impl StepProblem<'_> {
@@ -109,6 +113,9 @@ impl StepProblem<'_> {
         inherited: Option<Arc<Inherited>>,
         inner_tolerance: f64,
     ) -> Result<([f64; 4], ContactState, bool), SolveFailure> {
+        if let Some(count) = self.evaluations {
+            count.set(count.get() + 1);
+        }
         let m = self.disc.nodes();
         let k = Couplings::new(self.model, guess.split);
         let points = Points::new(self.disc, g);

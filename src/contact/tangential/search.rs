@@ -1,10 +1,10 @@
 //! The search for a step's geometry `(lo, hi, a, c)` (tangential module docs): the attempt
 //! plan of `solve_slip` (a recalled step, Masing's return to a remembered turning state, the
-//! stick-zone guesses and slip-sign patterns in turn, Newton's fallback), the quasi-Newton
-//! iteration of one attempt (`solve_geometry`) and its finite-difference and coarse-grid
-//! Jacobians.
+//! stick-zone guesses and slip-sign patterns in turn, Newton's fallback, within the step's
+//! bound on residual evaluations where one is set), the quasi-Newton iteration of one attempt
+//! (`solve_geometry`) and its finite-difference and coarse-grid Jacobians.
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::sync::Arc;
 
 use crate::contact::memory::Memory;
@@ -91,6 +91,8 @@ pub fn solve_slip(
     }
     let mut attempts = Attempts::default();
     let scratch = RefCell::default();
+    // The step's residual evaluations, which `options.step_evaluations` bounds.
+    let spent = Cell::new(0);
     let problem_for = |signs: (f64, f64)| StepProblem {
         model,
         disc,
@@ -101,6 +103,7 @@ pub fn solve_slip(
         tangential_load,
         scratch: &scratch,
         accelerations: options.accelerations,
+        evaluations: Some(&spent),
     };
     if let Some(step) = recalled.and_then(|r| recall(&problem_for, start, r, options)) {
         return Ok(step);
@@ -122,6 +125,11 @@ pub fn solve_slip(
                 break 'attempts;
             }
             let problem = problem_for(signs);
+            // The step's evaluation budget, once an attempt has failed (its failure is the
+            // one reported).
+            if attempts.first_failure.is_some() && budget_spent(&problem, options) {
+                break 'attempts;
+            }
             let method = match warm {
                 _ if newton => Method::Newton,
                 Some(w) if w.signs == signs => Method::Broyden(Some(w.jacobian)),
@@ -143,6 +151,15 @@ pub fn solve_slip(
     match attempts.stalled {
         Some(step) => Ok(*step),
         None => Err(attempts.first_failure.expect("at least one attempt")),
+    }
+}
+
+/// Whether the step's residual evaluations that `problem` counts have reached the step's
+/// bound ([`SlipOptions::step_evaluations`]).
+fn budget_spent(problem: &StepProblem<'_>, options: SlipOptions) -> bool {
+    match (options.step_evaluations, problem.evaluations) {
+        (Some(bound), Some(spent)) => spent.get() >= bound,
+        _ => false,
     }
 }
 
@@ -255,7 +272,9 @@ fn try_attempt(
     match solve_geometry(problem, start, start, attempt, method, options) {
         Ok(step) => Some(step),
         Err(failed) => {
-            let retry = failed.stalled.is_some() && method.within_phase();
+            let retry = failed.stalled.is_some()
+                && method.within_phase()
+                && !budget_spent(problem, options);
             attempts.record(failed);
             if retry {
                 let fresh = Method::Broyden(None);
@@ -317,6 +336,9 @@ fn masing_return<'a>(
         let signs = (turning.traction.left_sign, turning.traction.right_sign);
         if signs != (sign, sign) || zone.lo < lo0 || zone.hi > hi0 {
             continue;
+        }
+        if budget_spent(&probe, options) {
+            break;
         }
         let method = Method::Broyden(None);
         let guess = ((zone.lo, zone.hi), None);
@@ -395,6 +417,7 @@ fn coarse_jacobian(
     let coarse = StepProblem {
         disc: problem.disc.coarse()?,
         scratch: &maps,
+        evaluations: None,
         ..*problem
     };
     let (r, state, _) = coarse.evaluate(g, guess, INNER_TOLERANCE).ok()?;
@@ -517,7 +540,7 @@ fn solve_geometry(
         if size < options.tolerance {
             return Ok(search.accept(state, &g, (iter, evaluations), size, jac)?);
         }
-        if evaluations > search.budget(quasi_newton, size) {
+        if evaluations > search.budget(quasi_newton, size) || budget_spent(problem, options) {
             break;
         }
         let j = match jac {
@@ -904,6 +927,54 @@ mod tests {
                     previous = Some(fine);
                 }
             }
+        }
+    }
+
+    /// A step's bound on its residual evaluations (`SlipOptions::step_evaluations`, with the
+    /// options of `numerics.solver = auto`) counts the evaluations the step reports: a bound of
+    /// the evaluations a step needs leaves it as it is, to the bit; a bound of one ends the
+    /// step after the first residual of its first attempt, with that attempt's failure.
+    #[test]
+    fn the_evaluation_bound_ends_a_step_and_changes_none_within_it() {
+        use crate::history::{LoadPoint, RunOptions, SolverChoice, Tried, try_step};
+        let sc = crate::scenario::default_scenario();
+        let disc = Discretisation::new(64);
+        let limit = sc.model.friction * sc.normal_load;
+        let mut driver = crate::history::driver_after_normal_loading(&sc, &disc);
+        let point = |step: usize| LoadPoint {
+            step,
+            t: step as f64,
+            q: 0.05 * step as f64 * limit,
+            punch: None,
+        };
+        for step in 1..=3 {
+            advance_driver(&sc, &disc, &mut driver, point(step));
+        }
+        let auto = RunOptions::new(SolverChoice::Auto).slip;
+        let solve = |bound| {
+            let options = SlipOptions {
+                step_evaluations: bound,
+                ..auto
+            };
+            match try_step(&sc.model, &disc, &driver, point(4), options) {
+                Ok(Tried::Slip(trial)) => Ok(trial.solved),
+                Ok(Tried::Hold(_)) => panic!("a slip step"),
+                Err(failure) => Err(failure.failure),
+            }
+        };
+        let free = solve(None).expect("the step converges");
+        let needed = free.newton_iterations;
+        assert!(needed > 1, "{needed} evaluations");
+        let bounded = solve(Some(needed)).expect("within its bound");
+        assert_eq!(bounded.newton_iterations, needed);
+        let bits = |s: &SlipStep| {
+            let zone = s.state.traction.stick.as_ref().expect("stick zone");
+            [zone.lo, zone.hi, s.state.half_width, s.state.centre, s.residual].map(f64::to_bits)
+        };
+        assert_eq!(bits(&bounded), bits(&free));
+        match solve(Some(1)) {
+            Err(SolveFailure::NoConvergence { iterations, .. }) => assert_eq!(iterations, 1),
+            other => panic!("{other:?}"),
         }
     }
 
