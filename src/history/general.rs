@@ -99,8 +99,10 @@ pub struct RunOptions {
 impl RunOptions {
     /// The default options for a choice of solver. Under [`SolverChoice::Auto`] the spectral
     /// solver has no last resorts: it accepts no step at a stalled residual
-    /// (`stall_tolerance` 0) and does not repeat its failed attempts with Newton's method
-    /// (`newton_fallback` off); the general solver takes such a step instead.
+    /// (`stall_tolerance` 0), does not repeat its failed attempts with Newton's method
+    /// (`newton_fallback` off), and gives a step up after
+    /// [`SlipOptions::STEP_EVALUATIONS_BEHIND_ANOTHER_SOLVER`] residual evaluations over all
+    /// its attempts (`step_evaluations`); the general solver takes such a step instead.
     pub fn new(solver: SolverChoice) -> Self {
         let slip = match solver {
             SolverChoice::Auto => SlipOptions {
