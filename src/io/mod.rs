@@ -21,7 +21,8 @@
 //! ([`crate::analysis::CycleAnalysis`]), the summary's counts and the steps the history plots
 //! draw (all of a history of up to 4,096 steps, else the first and the last 2,048 cut to whole
 //! phases). Its memory does not grow with the history's length but for a row per cycle (and
-//! the turning-point states that `output.turning_point_fields = all` asks for). [`solve`]
+//! the turning-point states that `output.turning_point_fields = all` asks for, each with its
+//! subsurface grid under `output.subsurface`). [`solve`]
 //! returns every record.
 
 internal! { mod checkpoint; }
@@ -31,6 +32,7 @@ internal! { mod history_plots; }
 internal! { mod plots; }
 internal! { mod png; }
 internal! { mod run; }
+internal! { mod subsurface; }
 pub mod summary;
 internal! { mod svg; }
 internal! { mod sweep; }
@@ -39,4 +41,5 @@ mod sweep_plots;
 pub use self::csv::{Column, Table, cycles_table, fields_table, steps_table};
 pub(crate) use run::run_resumed;
 pub use run::{FieldSet, RunResult, Solution, run, run_partial, solve};
+pub use subsurface::{SubsurfaceGrid, SubsurfaceMap, subsurface_table};
 pub(crate) use sweep::{Shard, SweepOptions, Vary, sweep};

@@ -20,6 +20,7 @@ use crate::io::plots::{
     FamilyMember, PlotScales, ZoneEnds, family_plots, index_html, normal_loading_plots,
 };
 use crate::io::png::plot_files;
+use crate::io::subsurface::{SubsurfaceMap, SubsurfaceOutput, subsurface_plots, subsurface_table};
 use crate::io::summary::{
     Handover, HandoverLog, RecordTally, Resolved, SnapshotSummary, Summary, derived,
     history_summary, normal_summary, solver_statistics,
@@ -96,6 +97,9 @@ pub struct FieldSet {
     pub points: Vec<SurfacePoint>,
     /// Where the contact and the stick zone end (marked on the plots).
     pub ends: ZoneEnds,
+    /// The fields below the surface at the same instant (`output.subsurface`), written to
+    /// `subsurface/<stem>.csv`.
+    pub subsurface: Option<SubsurfaceMap>,
 }
 
 /// Keeps, while the history runs, the states that the field files need: the turning points
@@ -492,15 +496,65 @@ pub(crate) fn solve_from<'a>(
             .collect()
     };
     let loaded = normal.solved_state();
+    // The fields below the surface at the same instants, on a grid in units of the normal
+    // loading's half-width; a state whose fields cannot be computed gets a warning instead.
+    let subsurface = scenario.raw.output.subsurface.as_ref().and_then(|raw| {
+        SubsurfaceOutput::new(&model.material, raw, loaded.contact().1)
+            .map_err(|e| warnings.push(format!("the fields below the surface are not written: {e}")))
+            .ok()
+    });
+    if let Some(out) = &subsurface
+        && !out.has_von_mises()
+    {
+        warnings.push(
+            "the subsurface files have no syy_Pa and von_mises_Pa (σyy needs c12, which only the \
+             presets carry); the maps show the in-plane maximum shear stress instead"
+                .into(),
+        );
+    }
+    let subsurface_failures = std::cell::RefCell::new(Vec::new());
+    let below = |stem: &str, state: &SolvedState| -> Option<SubsurfaceMap> {
+        let out = subsurface.as_ref()?;
+        out.map(state)
+            .map_err(|e| {
+                subsurface_failures
+                    .borrow_mut()
+                    .push(format!("subsurface/{stem}.csv is not written: {e}"))
+            })
+            .ok()
+    };
     let mut fields = vec![FieldSet {
         stem: "normal_loading".into(),
         label: "end of normal loading".into(),
         points: sample(&loaded),
         ends: zone_ends(&loaded, &normal.record(0.0)),
+        subsurface: below("normal_loading", &loaded),
     }];
-    let (at_snapshots, snapshot_rows) =
-        snapshot_fields(scenario, &kept.at_times, &sample, tally.last(), &mut warnings);
+    let (at_snapshots, snapshot_rows) = snapshot_fields(
+        scenario,
+        &kept.at_times,
+        &sample,
+        &below,
+        tally.last(),
+        &mut warnings,
+    );
     fields.extend(at_snapshots);
+    // Turning points and the last step, unless switched off.
+    let mut turning_fields = Vec::new();
+    if scenario.raw.output.turning_point_fields != TurningFields::None {
+        let turning = kept.turning.iter().chain(&kept.last);
+        for (rec, state) in turning.chain(kept.previous.iter()) {
+            let stem = format!("step_{:05}", rec.step);
+            turning_fields.push(FieldSet {
+                label: format!("step {}", rec.step),
+                points: sample(state),
+                ends: zone_ends(state, rec),
+                subsurface: below(&stem, state),
+                stem,
+            });
+        }
+    }
+    warnings.extend(subsurface_failures.into_inner());
     let summary = Summary {
         fretsim_version: env!("CARGO_PKG_VERSION"),
         scenario: scenario.raw.clone(),
@@ -515,19 +569,6 @@ pub(crate) fn solve_from<'a>(
         solver: solver_statistics(scenario, &normal, &tally, kept.handovers),
         warnings,
     };
-    // Turning points and the last step, unless switched off.
-    let mut turning_fields = Vec::new();
-    if scenario.raw.output.turning_point_fields != TurningFields::None {
-        let turning = kept.turning.iter().chain(&kept.last);
-        for (rec, state) in turning.chain(kept.previous.iter()) {
-            turning_fields.push(FieldSet {
-                stem: format!("step_{:05}", rec.step),
-                label: format!("step {}", rec.step),
-                points: sample(state),
-                ends: zone_ends(state, rec),
-            });
-        }
-    }
     Ok(Solution {
         summary,
         fields,
@@ -605,12 +646,13 @@ fn stalled_warning(tally: &RecordTally) -> Option<String> {
     ))
 }
 
-/// The field sets and summary rows of the snapshot times reached; a warning for each one not
-/// reached.
+/// The field sets (the surface samples of `sample`, the fields below the surface of `below`)
+/// and summary rows of the snapshot times reached; a warning for each one not reached.
 fn snapshot_fields(
     scenario: &Scenario,
     at_times: &[Option<(StepRecord, SolvedState)>],
     sample: &dyn Fn(&SolvedState) -> Vec<SurfacePoint>,
+    below: &dyn Fn(&str, &SolvedState) -> Option<SubsurfaceMap>,
     last: Option<&StepRecord>,
     warnings: &mut Vec<String>,
 ) -> (Vec<FieldSet>, Vec<SnapshotSummary>) {
@@ -631,6 +673,7 @@ fn snapshot_fields(
             stem: stem.clone(),
             points: sample(state),
             ends: zone_ends(state, rec),
+            subsurface: below(&stem, state),
         });
         rows.push(SnapshotSummary {
             t,
@@ -685,6 +728,12 @@ pub(crate) fn write_solution(
                 format!("fields/{}.csv", set.stem),
                 &fields_table(&set.points).csv(),
             )?;
+            if let Some(map) = &set.subsurface {
+                put(
+                    format!("subsurface/{}.csv", set.stem),
+                    &subsurface_table(map).csv(),
+                )?;
+            }
         }
         let mut section = |title: &str, plots: Vec<(String, String)>| -> Result<(), Error> {
             let mut names = Vec::new();
@@ -724,6 +773,16 @@ pub(crate) fn write_solution(
             "Fields at the snapshot instants",
             family_plots("snapshots", "at the snapshot instants", &instants, &scales),
         )?;
+        let below: Vec<(String, String)> = fields
+            .iter()
+            .chain(turning_fields)
+            .filter_map(|set| {
+                let map = set.subsurface.as_ref()?;
+                Some(subsurface_plots(&set.stem, &set.label, map, &set.ends, &scales))
+            })
+            .flatten()
+            .collect();
+        section("Fields below the surface", below)?;
     }
     if let Some(e) = failure {
         let json = failure_json(e, last.as_ref(), failure_state.as_ref());

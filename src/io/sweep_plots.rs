@@ -17,7 +17,7 @@ pub(crate) struct ResultColumn {
 }
 
 /// Sequential colour map (viridis, sampled at five points and interpolated linearly).
-fn colour_map(u: f64) -> String {
+pub(crate) fn colour_map(u: f64) -> String {
     const STOPS: [(f64, f64, f64); 5] = [
         (68.0, 1.0, 84.0),
         (59.0, 82.0, 139.0),
@@ -49,7 +49,7 @@ const CATEGORY_COLOURS: [&str; 6] = [
 ];
 
 /// A value in three significant digits.
-fn short(v: f64) -> String {
+pub(crate) fn short(v: f64) -> String {
     if v.is_finite() && v.abs() > 0.0 && !(1e-3..1e4).contains(&v.abs()) {
         format!("{v:.2e}")
     } else {

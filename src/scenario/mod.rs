@@ -167,6 +167,16 @@ pub const MAX_FIELD_POINTS: usize = 100_000;
 /// Most snapshot times (`output.snapshots`).
 pub const MAX_SNAPSHOTS: usize = 10_000;
 
+/// Most columns, and most rows, of the subsurface grid (`output.subsurface.nx`, `.nz`).
+pub const MAX_SUBSURFACE_AXIS: usize = 1001;
+
+/// Most points of the subsurface grid (`nx·nz`): about 20 s per instant for PZT-4 on two
+/// cores.
+pub const MAX_SUBSURFACE_POINTS: usize = 250_000;
+
+/// Largest |x|/a and depth z/a of the subsurface grid.
+pub const MAX_SUBSURFACE_EXTENT: f64 = 100.0;
+
 /// Check every rule; return all problems at once. Nothing whose size comes from the input
 /// (the repeated cycle, the load steps) is expanded before its size is checked.
 ///

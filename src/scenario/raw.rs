@@ -62,6 +62,59 @@ pub struct RawOutput {
     /// nominal size; default false: rendering costs about 0.1 s and tens of MB per plot).
     #[serde(default)]
     pub png: bool,
+    /// Fields below the surface (stresses, von Mises, and the electric fields of a
+    /// piezoelectric solid) on a grid of points (x, z), written to `subsurface/<stem>.csv`
+    /// and mapped at every instant that gets a field file; absent (the default): none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub subsurface: Option<RawSubsurface>,
+}
+
+/// The grid of `output.subsurface`, in units of the contact half-width a at the end of normal
+/// loading: `nx` columns evenly spaced over `x_range` (x from the punch axis) and `nz` rows
+/// evenly spaced over depths `[0, depth]`, the first at the surface limit (evaluated at
+/// z = 1e−9 a, just below the surface).
+#[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSubsurface {
+    /// Deepest row, z/a (> 0 and ≤ 100; default 2).
+    #[serde(default = "default_subsurface_depth")]
+    pub depth: f64,
+    /// First and last column, x/a (finite, increasing, within ±100; default [−2, 2]).
+    #[serde(default = "default_subsurface_x_range")]
+    pub x_range: [f64; 2],
+    /// Columns (2 … 1001; default 81).
+    #[serde(default = "default_subsurface_nx")]
+    pub nx: usize,
+    /// Rows (2 … 1001; default 41); nx·nz ≤ 250,000.
+    #[serde(default = "default_subsurface_nz")]
+    pub nz: usize,
+}
+
+impl Default for RawSubsurface {
+    fn default() -> Self {
+        Self {
+            depth: default_subsurface_depth(),
+            x_range: default_subsurface_x_range(),
+            nx: default_subsurface_nx(),
+            nz: default_subsurface_nz(),
+        }
+    }
+}
+
+fn default_subsurface_depth() -> f64 {
+    2.0
+}
+
+fn default_subsurface_x_range() -> [f64; 2] {
+    [-2.0, 2.0]
+}
+
+fn default_subsurface_nx() -> usize {
+    81
+}
+
+fn default_subsurface_nz() -> usize {
+    41
 }
 
 /// Which turning points get field files (`output.turning_point_fields`).
@@ -120,6 +173,7 @@ impl Default for RawOutput {
             field_points: default_field_points(),
             plot_units: PlotUnits::default(),
             png: false,
+            subsurface: None,
         }
     }
 }

@@ -594,6 +594,9 @@ pub(super) fn validate_output(
     span: Option<(f64, f64)>,
     has_history: bool,
 ) -> f64 {
+    if let Some(grid) = &out.subsurface {
+        validate_subsurface(issues, grid);
+    }
     let n = out.field_points;
     if !(16..=MAX_FIELD_POINTS).contains(&n) || !n.is_multiple_of(4) {
         issues.push(Issue::new(
@@ -659,4 +662,52 @@ pub(super) fn validate_output(
         }
     }
     tol
+}
+
+/// Check the subsurface grid (`output.subsurface`): its extent in units of a and its size.
+fn validate_subsurface(issues: &mut Vec<Issue>, grid: &RawSubsurface) {
+    let depth = grid.depth;
+    if !(depth.is_finite() && depth > 0.0 && depth <= MAX_SUBSURFACE_EXTENT) {
+        issues.push(Issue::new(
+            "output.subsurface.depth",
+            format!(
+                "{depth} is invalid; it must be in (0, {MAX_SUBSURFACE_EXTENT}] (the deepest row, z/a)"
+            ),
+        ));
+    }
+    let [x0, x1] = grid.x_range;
+    for (i, x) in [x0, x1].into_iter().enumerate() {
+        if !(x.is_finite() && x.abs() <= MAX_SUBSURFACE_EXTENT) {
+            issues.push(Issue::new(
+                format!("output.subsurface.x_range[{i}]"),
+                format!(
+                    "{x} is invalid; it must be finite and within [−{MAX_SUBSURFACE_EXTENT}, {MAX_SUBSURFACE_EXTENT}] (x/a)"
+                ),
+            ));
+        }
+    }
+    if x0.is_finite() && x1.is_finite() && x1 <= x0 {
+        issues.push(Issue::new(
+            "output.subsurface.x_range[1]",
+            format!("{x1} is invalid; it must be > x_range[0] = {x0} (x/a)"),
+        ));
+    }
+    let axis_ok = |n: usize| (2..=MAX_SUBSURFACE_AXIS).contains(&n);
+    for (name, n) in [("nx", grid.nx), ("nz", grid.nz)] {
+        if !axis_ok(n) {
+            issues.push(Issue::new(
+                format!("output.subsurface.{name}"),
+                format!("{n} is invalid; it must be in [2, {MAX_SUBSURFACE_AXIS}]"),
+            ));
+        }
+    }
+    if axis_ok(grid.nx) && axis_ok(grid.nz) && grid.nx * grid.nz > MAX_SUBSURFACE_POINTS {
+        issues.push(Issue::new(
+            "output.subsurface",
+            format!(
+                "nx·nz = {} points is invalid; it must be at most {MAX_SUBSURFACE_POINTS}",
+                grid.nx * grid.nz
+            ),
+        ));
+    }
 }

@@ -353,6 +353,53 @@ mod history {
     }
 
     #[test]
+    fn subsurface_rules_name_the_field() {
+        let found = issues_of(&with_output(
+            r#"{"subsurface": {"depth": 0.0, "x_range": [1.0, -1.0], "nx": 1, "nz": 5000}}"#,
+        ));
+        let shown: Vec<String> = found.iter().map(|i| i.to_string()).collect();
+        assert_eq!(
+            shown,
+            [
+                "`output.subsurface.depth` = 0 is invalid; it must be in (0, 100] (the deepest row, z/a)",
+                "`output.subsurface.x_range[1]` = -1 is invalid; it must be > x_range[0] = 1 (x/a)",
+                "`output.subsurface.nx` = 1 is invalid; it must be in [2, 1001]",
+                "`output.subsurface.nz` = 5000 is invalid; it must be in [2, 1001]",
+            ]
+        );
+        let found = issues_of(&with_output(
+            r#"{"subsurface": {"depth": 1e9, "x_range": [-200.0, 0.0], "nx": 1000, "nz": 1000}}"#,
+        ));
+        let shown: Vec<String> = found.iter().map(|i| i.to_string()).collect();
+        assert_eq!(
+            shown,
+            [
+                "`output.subsurface.depth` = 1000000000 is invalid; it must be in (0, 100] (the deepest row, z/a)",
+                "`output.subsurface.x_range[0]` = -200 is invalid; it must be finite and within [−100, 100] (x/a)",
+                "`output.subsurface` = nx·nz = 1000000 points is invalid; it must be at most 250000",
+            ]
+        );
+        // Every field has a default; absent, nothing below the surface is asked for.
+        let s = check(&with_output(r#"{"subsurface": {}}"#)).unwrap();
+        assert_eq!(
+            s.raw.output.subsurface,
+            Some(RawSubsurface {
+                depth: 2.0,
+                x_range: [-2.0, 2.0],
+                nx: 81,
+                nz: 41
+            })
+        );
+        assert!(default_scenario().raw.output.subsurface.is_none());
+        match check(&with_output(r#"{"subsurface": {"depht": 1.0}}"#)) {
+            Err(Error::ParseScenario { message, .. }) => {
+                assert!(message.contains("depht"), "{message}")
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
     fn snapshot_times_off_the_step_grid_become_history_points() {
         // Default history: 10 steps on [0, 1] (max step 0.05 ηP over 0.5 ηP), so 0.3 is a step
         // time and 0.35 is not. Splitting [0, 1] at 0.35 regrids [0, 0.35] into 10 steps

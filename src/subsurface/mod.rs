@@ -284,6 +284,15 @@ impl SubsurfaceKernel {
         self
     }
 
+    /// Whether the fields have σyy and the von Mises stress: always for an isotropic solid,
+    /// with c12 for a piezoelectric one.
+    pub fn has_sigma_yy(&self) -> bool {
+        match &self.kind {
+            Kind::Isotropic { .. } => true,
+            Kind::Piezoelectric { c12, .. } => c12.is_some(),
+        }
+    }
+
     /// `‖B‖‖B⁻¹‖` of the decaying modes' eigenvectors (dimensionless, unit displacement
     /// eigenvectors): the modal sum loses about its logarithm in digits (PZT-4: 16; refused
     /// above 1e6). `None` for the isotropic solid.

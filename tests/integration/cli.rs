@@ -183,6 +183,9 @@ fn read_summary(dir: &Path) -> Summary {
 }
 
 const FIELDS_HEADER: &str = "x_m,p_Pa,q_Pa,g_C_per_m2,sigma_xx_Pa,d_x_C_per_m2";
+const SUBSURFACE_HEADER: &str = "x_m,z_m,x_over_a,z_over_a,sxx_Pa,szz_Pa,sxz_Pa,syy_Pa,\
+von_mises_Pa,principal_1_Pa,principal_2_Pa,max_shear_Pa";
+const SUBSURFACE_ELECTRIC: &str = ",d_x_C_per_m2,d_z_C_per_m2,e_x_V_per_m,e_z_V_per_m";
 const STEPS_HEADER: &str = "step,t_s,Q_N_per_m,Q_over_etaP,P_N_per_m,charge_C_per_m,potential_V,regime,phase,a_m,e_m,stick_lo_m,stick_hi_m,\
 left_slip_sign,right_slip_sign,newton_iterations,evaluations,residual,stick_excess,slip_reversal,\
 delta_m,dissipation_J_per_m,solver,stick_zones,slip_zones,slip_sign_changes";
@@ -398,6 +401,40 @@ fn run_checked(scenario: &Path) -> (tempfile::TempDir, PathBuf, Summary) {
         check_fields(&snap.file);
         assert!(snap.stick_lo < snap.stick_hi && snap.half_width > 0.0);
     }
+    // The fields below the surface: a file and a map beside every field file, or none.
+    let fields: Vec<String> = std::fs::read_dir(out.join("fields"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    let grid = &raw["output"]["subsurface"];
+    if grid.is_null() {
+        assert!(!out.join("subsurface").exists());
+    } else {
+        let count = |key: &str, default: u64| grid[key].as_u64().unwrap_or(default) as usize;
+        let (nx, nz) = (count("nx", 81), count("nz", 41));
+        let piezo = raw["material"]["kind"] != "elastic";
+        for file in &fields {
+            let path = format!("subsurface/{file}");
+            let (header, rows) = read_csv(&out.join(&path));
+            let electric = if piezo { SUBSURFACE_ELECTRIC } else { "" };
+            assert_eq!(header, format!("{SUBSURFACE_HEADER}{electric}"), "{path}");
+            assert_eq!(rows.len(), nx * nz, "{path}");
+            assert!(index.contains(&path), "index.html lists {path}");
+            let stem = file.trim_end_matches(".csv");
+            let mut maps = vec![format!("plots/subsurface_{stem}_von_mises.svg")];
+            if piezo {
+                maps.push(format!("plots/subsurface_{stem}_d.svg"));
+            }
+            for map in maps {
+                assert_svg(&out.join(&map), 1);
+                assert!(index.contains(&map), "index.html shows {map}");
+            }
+        }
+        assert_eq!(
+            std::fs::read_dir(out.join("subsurface")).unwrap().count(),
+            fields.len()
+        );
+    }
     for q in ["p", "q", "g", "sigma_xx", "d_x"] {
         let plot = out.join(format!("plots/snapshots_{q}.svg"));
         if requested.is_empty() {
@@ -415,7 +452,7 @@ fn run_scenario(name: &str) -> (tempfile::TempDir, PathBuf, Summary) {
 }
 
 /// The scenarios with a test of their own below; a file in `scenarios/` without one fails.
-const SCENARIOS: [&str; 16] = [
+const SCENARIOS: [&str; 17] = [
     "baseline",
     "charge_history",
     "cattaneo_mindlin_uncoupled",
@@ -431,6 +468,7 @@ const SCENARIOS: [&str; 16] = [
     "normal_load_in_phase",
     "partial_unload_reload",
     "small_friction_below_gamma1",
+    "subsurface_map",
     "variable_amplitude",
 ];
 
@@ -772,6 +810,187 @@ fn scenario_cattaneo_mindlin_uncoupled() {
     assert!((ratio(0) - 0.4f64.sqrt()).abs() < 1e-9, "{}", ratio(0));
     assert!((ratio(2) - 0.4f64.sqrt()).abs() < 1e-9, "{}", ratio(2));
     assert_same_traction(&out, &[(1.0, 3.0)], 1e-8);
+}
+
+/// McEwen (1949), Johnson *Contact Mechanics* eqs. (7.5)–(7.7): `(σxx, σzz, σxz)` of a Hertz
+/// line contact of half-width 1 and peak pressure 1 (`normal`) and of the sliding traction
+/// `q = √(1 − x²)` on the half-plane (`tangential`), at (x, z) in units of the half-width.
+fn mcewen(x: f64, z: f64) -> ([f64; 3], [f64; 3]) {
+    let b = 1.0 - x * x + z * z;
+    let root = (b * b + 4.0 * x * x * z * z).sqrt();
+    let (m2, n2) = if b >= 0.0 {
+        let m2 = 0.5 * (root + b);
+        (m2, x * x * z * z / m2)
+    } else {
+        let n2 = 0.5 * (root - b);
+        (x * x * z * z / n2, n2)
+    };
+    let (m, n) = (m2.sqrt(), x.signum() * n2.sqrt());
+    let d = m * m + n * n;
+    let normal = [
+        -(m * (1.0 + (z * z + n * n) / d) - 2.0 * z),
+        -m * (1.0 - (z * z + n * n) / d),
+        -n * (m * m - z * z) / d,
+    ];
+    let tangential = [
+        n * (2.0 - (z * z - m * m) / d) - 2.0 * x,
+        -n * (m * m - z * z) / d,
+        -(m * (1.0 + (z * z + n * n) / d) - 2.0 * z),
+    ];
+    (normal, tangential)
+}
+
+/// The fields below the surface of the uncoupled cylinder (ν = 0.5, η = 0.3), against closed
+/// forms.
+/// - Every grid point (80 × 41 over |x| ≤ 1.975 a, z ≤ 2 a) of the end of normal loading
+///   (Hertz, McEwen's normal part), of Q = ½ηP (t = 1 s, Cattaneo–Mindlin: c/a = √½, the
+///   traction η[T(x, z) − (c/a) T(x/c, z/c)] with T McEwen's sliding traction's field) and of
+///   the turning point at −½ηP (step 30, Mindlin–Deresiewicz: the same traction reversed):
+///   σxx, σzz, σxz within 5.7e−12 p0 (measured), against the 5e−11 p0 that the file's 11
+///   significant digits allow.
+/// - The first row (z = 1e−9 a) against the field files' surface values at the same x: σxx
+///   and σxx0 (seed eq. 64) within 7.1e−9 p0, σzz and −p 1.3e−9 p0, σxz and −q 5.3e−9 p0
+///   (measured: the fields' change over 1e−9 a, largest at the columns 0.025 a inside the
+///   contact ends); tolerance 1e−8 p0.
+/// - The largest von Mises stress under Hertz with ν = 0.5 (σyy = (σxx + σzz)/2, so
+///   σvM = √3 τmax): 0.520106 p0 at z = 0.786152 a on the axis (√3 × Johnson's 0.300283 p0).
+///   The grid's largest value is at z = 0.80 a, 0.025 a off the axis; the parabola through it
+///   and the rows above and below peaks 9.9e−4 a deeper and 5.2e−5 p0 lower (measured: the
+///   parabola's error over rows 0.05 a apart, and the offset from the axis); tolerances
+///   2e−3 a and 1e−4 p0.
+#[test]
+fn scenario_subsurface_map() {
+    let (_tmp, out, s) = run_scenario("subsurface_map");
+    let (a, p0) = (s.normal_loading.half_width, s.normal_loading.peak_pressure);
+    let (nx, nz) = (80, 41);
+    let eta = 0.3;
+    let read = |stem: &str| {
+        let (header, rows) = read_csv(&out.join(format!("subsurface/{stem}.csv")));
+        let header: Vec<String> = header.split(',').map(String::from).collect();
+        let col = |name: &str| -> Vec<f64> {
+            let k = header.iter().position(|h| h == name).unwrap();
+            rows.iter().map(|r| r[k]).collect()
+        };
+        (
+            col("x_over_a"),
+            col("z_over_a"),
+            col("sxx_Pa"),
+            col("szz_Pa"),
+            col("sxz_Pa"),
+            col("von_mises_Pa"),
+            col("max_shear_Pa"),
+        )
+    };
+    let steps = read_csv(&out.join("steps.csv")).1;
+    assert!((steps[30][3] + 0.5).abs() < 1e-12, "step 30 is at −½ηP");
+    let c = 0.5f64.sqrt();
+    for (stem, load) in [
+        ("normal_loading", 0.0),
+        ("t_1.000000", 1.0),
+        ("step_00030", -1.0),
+    ] {
+        let (x, z, sxx, szz, sxz, vm, tau) = read(stem);
+        assert_eq!(x.len(), nx * nz);
+        let mut worst = 0.0f64;
+        for i in 0..x.len() {
+            let (normal, slide) = mcewen(x[i], z[i]);
+            let (_, inner) = mcewen(x[i] / c, z[i] / c);
+            for (k, got) in [sxx[i], szz[i], sxz[i]].into_iter().enumerate() {
+                let want = normal[k] + load * eta * (slide[k] - c * inner[k]);
+                worst = worst.max((got / p0 - want).abs());
+            }
+            // ν = 0.5: σvM = √3 τmax.
+            assert!((vm[i] - 3f64.sqrt() * tau[i]).abs() <= 1e-10 * vm[i].abs().max(1e-6 * p0));
+        }
+        assert!(worst < 5e-11, "{stem}: {worst:e} p0 from the closed form");
+        // The first row against the field file's surface values.
+        let (_, fields) = read_csv(&out.join(format!("fields/{stem}.csv")));
+        for (i, f) in fields.iter().enumerate() {
+            assert!((z[i] - 1e-9).abs() < 1e-15 && (x[i] - f[0] / a).abs() < 1e-10);
+            assert!(
+                (sxx[i] - f[4]).abs() < 1e-8 * p0,
+                "{stem} σxx at x = {}",
+                x[i]
+            );
+            assert!(
+                (szz[i] + f[1]).abs() < 1e-8 * p0,
+                "{stem} σzz at x = {}",
+                x[i]
+            );
+            assert!(
+                (sxz[i] + f[2]).abs() < 1e-8 * p0,
+                "{stem} σxz at x = {}",
+                x[i]
+            );
+        }
+    }
+    let (x, z, _, _, _, vm, _) = read("normal_loading");
+    let top = (0..vm.len())
+        .max_by(|&i, &j| vm[i].total_cmp(&vm[j]))
+        .unwrap();
+    assert!((z[top] - 0.8).abs() < 1e-12 && (x[top].abs() - 0.025).abs() < 1e-12);
+    let [v0, v1, v2] = [top - nx, top, top + nx].map(|i| vm[i] / p0);
+    let h = z[top + nx] - z[top];
+    let shift = 0.5 * h * (v0 - v2) / (v0 - 2.0 * v1 + v2);
+    let peak = v1 - 0.25 * (v0 - v2) * shift / h;
+    let (z_peak, vm_peak) = (0.786152, 0.520106);
+    assert!(
+        (z[top] + shift - z_peak).abs() < 2e-3,
+        "z = {} a",
+        z[top] + shift
+    );
+    assert!((peak - vm_peak).abs() < 1e-4, "σvM = {peak} p0");
+}
+
+/// The paper's baseline contact (PZT-4, conducting punch) with fields below the surface to
+/// 1 a: the table has D and E, a map of |D| is drawn, and the first row (z = 1e−9 a) meets the
+/// field file's surface values at the same x. Measured: σxx and σxx0 (eq. 64) 9.1e−9 p0, σzz
+/// and −p 1.3e−9 p0, σxz and −q 4.2e−9 p0, Dz and −g 4.7e−9 of max |g|, Dx and Dx0 (eq. 65)
+/// 3.3e−8 of max |Dx0| (at x = −0.975 a, where Dx0 changes fastest); tolerances 2e−8 p0,
+/// 1e−8 max |g| and 1e−7 max |Dx0|.
+#[test]
+fn subsurface_fields_of_a_piezoelectric_solid() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scenario_path("baseline")).unwrap()).unwrap();
+    v["output"] = serde_json::json!({"field_points": 80, "subsurface":
+        {"depth": 1.0, "x_range": [-1.975, 1.975], "nx": 80, "nz": 11}});
+    let file = tmp.path().join("piezo_subsurface.json");
+    std::fs::write(&file, v.to_string()).unwrap();
+    let (_tmp, out, s) = run_checked(&file);
+    let p0 = s.normal_loading.peak_pressure;
+    let (header, rows) = read_csv(&out.join("subsurface/normal_loading.csv"));
+    let (fh, fields) = read_csv(&out.join("fields/normal_loading.csv"));
+    let sub = |name: &str| column(&header, &rows, name);
+    let surf = |name: &str| column(&fh, &fields, name);
+    let largest = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let (g, dx0) = (surf("g_C_per_m2"), surf("d_x_C_per_m2"));
+    let pairs = [
+        ("sxx_Pa", surf("sigma_xx_Pa"), 1.0, 2e-8 * p0),
+        ("szz_Pa", surf("p_Pa"), -1.0, 2e-8 * p0),
+        ("sxz_Pa", surf("q_Pa"), -1.0, 2e-8 * p0),
+        ("d_z_C_per_m2", g.clone(), -1.0, 1e-8 * largest(&g)),
+        ("d_x_C_per_m2", dx0.clone(), 1.0, 1e-7 * largest(&dx0)),
+    ];
+    for (name, surface, sign, tol) in pairs {
+        let below = sub(name);
+        for (i, want) in surface.iter().enumerate() {
+            assert!(
+                (below[i] - sign * want).abs() < tol,
+                "{name} at x = {}: {} against {}",
+                fields[i][0],
+                below[i],
+                sign * want
+            );
+        }
+    }
+    // The von Mises stress is there (PZT-4's c12 is known) and positive below the surface.
+    assert!(
+        sub("von_mises_Pa")
+            .iter()
+            .all(|v| v.is_finite() && *v >= 0.0)
+    );
+    assert!(s.warnings.iter().all(|w| !w.contains("subsurface")));
 }
 
 /// The coupled elastic case (seed Figure 4 contact) under three ±½ηP cycles. From the second
@@ -1152,6 +1371,31 @@ fn bad_input_exits_2_names_the_field_and_writes_nothing() {
             "multiple of 4",
         ),
         (with("output.plots", json!(false)), "plots", "unknown field"),
+        (
+            with("output.subsurface", json!({"depth": -1.0})),
+            "output.subsurface.depth",
+            "must be in (0, 100]",
+        ),
+        (
+            with("output.subsurface", json!({"x_range": [2.0, 2.0]})),
+            "output.subsurface.x_range[1]",
+            "must be > x_range[0]",
+        ),
+        (
+            with("output.subsurface", json!({"nx": 1})),
+            "output.subsurface.nx",
+            "must be in [2, 1001]",
+        ),
+        (
+            with("output.subsurface", json!({"nx": 1000, "nz": 1000})),
+            "output.subsurface",
+            "at most 250000",
+        ),
+        (
+            with("output.subsurface", json!({"dx": 0.1})),
+            "dx",
+            "unknown field",
+        ),
     ];
     for (i, (text, field, rule)) in cases.iter().enumerate() {
         let file = tmp.path().join(format!("bad{i}.json"));

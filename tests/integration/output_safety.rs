@@ -172,6 +172,34 @@ fn a_previous_output_is_replaced_as_a_whole_and_a_users_file_protects_it() {
     assert_eq!(snapshot(tmp.path()), before);
 }
 
+/// The files below the surface are fretsim's like the others: listed in the manifest, gone
+/// when a later run into the folder does not ask for them, and a user's file among them
+/// protects the folder.
+#[test]
+fn subsurface_files_are_listed_and_a_users_file_among_them_protects_the_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let with_subsurface = scenario_path("subsurface_map");
+    assert!(run_into(Some(&with_subsurface), &out).status.success());
+    let listed = complete_output(&out);
+    assert!(listed.contains(&"subsurface/normal_loading.csv".to_string()));
+    assert!(listed.contains(&"plots/subsurface_normal_loading_von_mises.svg".to_string()));
+    assert!(
+        run_into(Some(&scenario_path("figure5_frictionless")), &out)
+            .status
+            .success()
+    );
+    complete_output(&out);
+    assert!(!out.join("subsurface").exists());
+    assert!(run_into(Some(&with_subsurface), &out).status.success());
+    std::fs::write(out.join("subsurface/my_grid.csv"), "mine").unwrap();
+    let before = snapshot(tmp.path());
+    let o = run_into(Some(&with_subsurface), &out);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("`subsurface/my_grid.csv`"));
+    assert_eq!(snapshot(tmp.path()), before);
+}
+
 /// Start a run that pauses at `stage` (the `FRETSIM_PAUSE_AT` hook) and wait until it is there.
 pub(crate) fn paused_run(scenario: Option<&Path>, out: &Path, stage: &str) -> Child {
     let mut cmd = fretsim();

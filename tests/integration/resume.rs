@@ -82,6 +82,28 @@ fn a_run_killed_and_resumed_writes_the_uninterrupted_runs_output_byte_for_byte()
     assert_eq!(snapshot(&part), snapshot(&full));
 }
 
+/// The fields below the surface of a resumed run are the uninterrupted run's, byte for byte:
+/// the history that changes P (element states of the general solver, whose loads are constant
+/// on the elements) with a subsurface grid, killed at its third checkpoint and resumed.
+#[test]
+fn a_resumed_run_writes_the_same_fields_below_the_surface() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(scenario_path("normal_load_in_phase")).unwrap(),
+    )
+    .unwrap();
+    v["output"]["subsurface"] = serde_json::json!({"depth": 1.0, "nx": 41, "nz": 11});
+    let scenario = tmp.path().join("in_phase_subsurface.json");
+    std::fs::write(&scenario, v.to_string()).unwrap();
+    let (full, part) = (tmp.path().join("full"), tmp.path().join("part"));
+    full_run(Some(&scenario), &full);
+    assert!(full.join("subsurface/normal_loading.csv").exists());
+    killed(paused_run(Some(&scenario), &part, "checkpoint 3"));
+    let o = resume(Some(&scenario), &part, None);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(snapshot(&part), snapshot(&full));
+}
+
 /// A long run (the default contact's cycle 120 times, 4,810 steps: its plots draw the first
 /// and the last steps) killed at its 220th checkpoint (step 4,390), with a partial line
 /// appended to its checkpoint's records as a run killed between the two writes of a
