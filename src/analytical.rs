@@ -6,6 +6,8 @@
 //! - Zhou & Lee (2012), frictionless conducting punch on a piezoelectric half-plane, in the
 //!   form derived in [`crate::contact`]: Hertz with `Y* = y22 − y23²/y33`, and
 //!   `g(x) = k p(x) + (Γ − kP)/(π √(a² − x²))`, `k = −y23/y33`.
+//! - McEwen (1949), the stresses below a Hertz line contact and below its sliding traction
+//!   ([`mcewen`]).
 //! - The flat punch with rounded corners (flat half-width b, corner radius R; Ciavarella,
 //!   Hills and Monno 1998, *Proc. IMechE C* 212, 319–328): [`FlatRounded`], its load, peak
 //!   pressure and, on an uncoupled half-plane, the Cattaneo-type stick zone.
@@ -308,4 +310,38 @@ pub fn wallis(n: f64) -> f64 {
 /// `P = (1/Y*)∫ x h'(x)/√(a² − x²) dx`, x = a sin φ), Hertz's at n = 2, A = 1/(2R).
 pub fn power_law_half_width(coefficient: f64, exponent: f64, load: f64, compliance: f64) -> f64 {
     (load * compliance / (2.0 * exponent * coefficient * wallis(exponent))).powf(1.0 / exponent)
+}
+
+/// McEwen (1949), Johnson *Contact Mechanics* eqs. (7.5)–(7.7): `(σxx, σzz, σxz)` below a
+/// Hertz line contact of half-width 1 and peak pressure 1 (`normal`: `p = √(1 − x²)`) and
+/// below the traction `q = √(1 − x²)` along +x on the half-plane (`tangential`, a sliding
+/// contact's), at (x, z) in units of the half-width, z ≥ 0 the depth; scale a contact of
+/// half-width a and peaks p0, q0 as `p0·normal(x/a, z/a) + q0·tangential(x/a, z/a)`. The
+/// normal part's σxz has the sign of Flamant's solution (`σxz = σr xz/r² < 0` for x > 0); the
+/// tangential part gives `σxz → −q` and `σxx → −2x` on the surface. With `m² = (root + b)/2`,
+/// `n² = (root − b)/2`, `b = 1 − x² + z²`, `root = √(b² + 4x²z²)`, the smaller of m², n² is
+/// taken from their product x²z² (no cancellation inside the contact near the surface).
+pub fn mcewen(x: f64, z: f64) -> ([f64; 3], [f64; 3]) {
+    let b = 1.0 - x * x + z * z;
+    let root = (b * b + 4.0 * x * x * z * z).sqrt();
+    let (m2, n2) = if b >= 0.0 {
+        let m2 = 0.5 * (root + b);
+        (m2, x * x * z * z / m2)
+    } else {
+        let n2 = 0.5 * (root - b);
+        (x * x * z * z / n2, n2)
+    };
+    let (m, n) = (m2.sqrt(), x.signum() * n2.sqrt());
+    let d = m * m + n * n;
+    let normal = [
+        -(m * (1.0 + (z * z + n * n) / d) - 2.0 * z),
+        -m * (1.0 - (z * z + n * n) / d),
+        -n * (m * m - z * z) / d,
+    ];
+    let tangential = [
+        n * (2.0 - (z * z - m * m) / d) - 2.0 * x,
+        -n * (m * m - z * z) / d,
+        -(m * (1.0 + (z * z + n * n) / d) - 2.0 * z),
+    ];
+    (normal, tangential)
 }

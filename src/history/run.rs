@@ -55,16 +55,8 @@ pub fn run_history(
     let mut state = normal.history_state();
     if history.control == Control::Displacement {
         // The spectral solver prescribes Q: the general solver holds every step.
-        if let (None, Some(driver)) = (&state.general, &state.driver) {
-            let mut recall = Recall::new(options.slip.accelerations.general_recall);
-            state.general = Some(GeneralRun::handover(
-                model,
-                driver,
-                options.general_element_size,
-                &mut recall,
-            ));
-        }
-        state.driver = None;
+        let mut recall = Recall::new(options.slip.accelerations.general_recall);
+        general_from_here(model, &mut state, options.general_element_size, &mut recall);
         if let Some(run) = state.general.as_mut() {
             run.control = Control::Displacement;
         }
@@ -187,15 +179,7 @@ pub fn continue_run(
             }
             // The spectral solver's memory cannot describe a past with another normal or
             // electric load: the general solver takes this step and every later one.
-            if let (None, Some(driver)) = (&state.general, &state.driver) {
-                state.general = Some(GeneralRun::handover(
-                    model,
-                    driver,
-                    options.general_element_size,
-                    &mut recall,
-                ));
-            }
-            state.driver = None;
+            general_from_here(model, state, options.general_element_size, &mut recall);
         }
         let (mut run, step) = match (state.general.take(), &mut state.driver) {
             (Some(mut run), _) => {
@@ -286,6 +270,21 @@ pub fn continue_run(
         next += 1;
     }
     None
+}
+
+/// Give the rest of the run to the general solver: hand the driver's state over (elements of
+/// at most `inner`·a) unless the general solver holds the steps already, and drop the
+/// spectral driver, whose memory cannot describe the past that follows.
+fn general_from_here(
+    model: &ContactModel,
+    state: &mut HistoryState,
+    inner: f64,
+    recall: &mut Recall,
+) {
+    if let (None, Some(driver)) = (&state.general, &state.driver) {
+        state.general = Some(GeneralRun::handover(model, driver, inner, recall));
+    }
+    state.driver = None;
 }
 
 /// Add `record` to `records`: after every earlier one when `all`, in place of them otherwise

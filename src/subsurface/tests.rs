@@ -26,40 +26,12 @@ fn legendre(n: usize, lo: f64, hi: f64) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// McEwen (1949) for a Hertz line contact with full sliding, `q = η p` on the half-plane
-/// (+x), as in Johnson, *Contact Mechanics* eqs. (7.5)–(7.7): `(σxx, σzz, σxz)` at (x, z).
-/// The normal part's σxz is written with the sign of Flamant's solution (a compressive radial
-/// stress: `σxz = σr xz/r² < 0` for x > 0); the tangential part gives `σxz → −q` and
-/// `σxx → −2q0 x/a` (compression ahead of the traction) on the surface.
+/// McEwen's fields ([`crate::analytical::mcewen`]) of a Hertz line contact of half-width a
+/// and peak p0 with full sliding, `q = q0/p0 · p` on the half-plane (+x): `(σxx, σzz, σxz)`
+/// at (x, z).
 fn mcewen(a: f64, p0: f64, q0: f64, x: f64, z: f64) -> [f64; 3] {
-    let b = a * a - x * x + z * z;
-    let root = (b * b + 4.0 * x * x * z * z).sqrt();
-    // m² = (root + b)/2, n² = (root − b)/2, m²n² = x²z²: the smaller from the product,
-    // without the cancellation of root − b (inside the contact near the surface).
-    let (m2, n2) = if b >= 0.0 {
-        let m2 = 0.5 * (root + b);
-        (m2, x * x * z * z / m2)
-    } else {
-        let n2 = 0.5 * (root - b);
-        (x * x * z * z / n2, n2)
-    };
-    let (m, n) = (m2.sqrt(), x.signum() * n2.sqrt());
-    let d = m * m + n * n;
-    let normal = [
-        -(p0 / a) * (m * (1.0 + (z * z + n * n) / d) - 2.0 * z),
-        -(p0 / a) * m * (1.0 - (z * z + n * n) / d),
-        -(p0 / a) * n * (m * m - z * z) / d,
-    ];
-    let tangential = [
-        (q0 / a) * (n * (2.0 - (z * z - m * m) / d) - 2.0 * x),
-        -(q0 / a) * n * (m * m - z * z) / d,
-        -(q0 / a) * (m * (1.0 + (z * z + n * n) / d) - 2.0 * z),
-    ];
-    [
-        normal[0] + tangential[0],
-        normal[1] + tangential[1],
-        normal[2] + tangential[2],
-    ]
+    let (normal, tangential) = crate::analytical::mcewen(x / a, z / a);
+    [0, 1, 2].map(|k| p0 * normal[k] + q0 * tangential[k])
 }
 
 /// Hertz contact of half-width `a` and peak `p0` on the contact centred at 0, with

@@ -812,34 +812,6 @@ fn scenario_cattaneo_mindlin_uncoupled() {
     assert_same_traction(&out, &[(1.0, 3.0)], 1e-8);
 }
 
-/// McEwen (1949), Johnson *Contact Mechanics* eqs. (7.5)–(7.7): `(σxx, σzz, σxz)` of a Hertz
-/// line contact of half-width 1 and peak pressure 1 (`normal`) and of the sliding traction
-/// `q = √(1 − x²)` on the half-plane (`tangential`), at (x, z) in units of the half-width.
-fn mcewen(x: f64, z: f64) -> ([f64; 3], [f64; 3]) {
-    let b = 1.0 - x * x + z * z;
-    let root = (b * b + 4.0 * x * x * z * z).sqrt();
-    let (m2, n2) = if b >= 0.0 {
-        let m2 = 0.5 * (root + b);
-        (m2, x * x * z * z / m2)
-    } else {
-        let n2 = 0.5 * (root - b);
-        (x * x * z * z / n2, n2)
-    };
-    let (m, n) = (m2.sqrt(), x.signum() * n2.sqrt());
-    let d = m * m + n * n;
-    let normal = [
-        -(m * (1.0 + (z * z + n * n) / d) - 2.0 * z),
-        -m * (1.0 - (z * z + n * n) / d),
-        -n * (m * m - z * z) / d,
-    ];
-    let tangential = [
-        n * (2.0 - (z * z - m * m) / d) - 2.0 * x,
-        -n * (m * m - z * z) / d,
-        -(m * (1.0 + (z * z + n * n) / d) - 2.0 * z),
-    ];
-    (normal, tangential)
-}
-
 /// The fields below the surface of the uncoupled cylinder (ν = 0.5, η = 0.3), against closed
 /// forms.
 /// - Every grid point (80 × 41 over |x| ≤ 1.975 a, z ≤ 2 a) of the end of normal loading
@@ -893,8 +865,8 @@ fn scenario_subsurface_map() {
         assert_eq!(x.len(), nx * nz);
         let mut worst = 0.0f64;
         for i in 0..x.len() {
-            let (normal, slide) = mcewen(x[i], z[i]);
-            let (_, inner) = mcewen(x[i] / c, z[i] / c);
+            let (normal, slide) = fretsim::analytical::mcewen(x[i], z[i]);
+            let (_, inner) = fretsim::analytical::mcewen(x[i] / c, z[i] / c);
             for (k, got) in [sxx[i], szz[i], sxz[i]].into_iter().enumerate() {
                 let want = normal[k] + load * eta * (slide[k] - c * inner[k]);
                 worst = worst.max((got / p0 - want).abs());
