@@ -39,9 +39,9 @@ pub struct CycleRow {
     /// Partial slip, gross slip or no slip ([`CycleRegime`]).
     pub regime: CycleRegime,
     /// The slip amplitude δ_s (m): half the range over the cycle of the slip displacement
-    /// `δ − C·Q`, with C the stuck compliance taken as `Δδ/ΔQ` of the cycle's first step (right
-    /// after its positive extreme every point sticks: C to first order in the step); `None`
-    /// when that step does not change Q.
+    /// `δ − C·Q`, with C the stuck compliance taken as `Δδ/ΔQ` from the cycle's positive
+    /// extreme to its first step that changes Q (right after the extreme every point sticks:
+    /// C to first order in the step); `None` when no step of the cycle changes Q.
     pub slip_amplitude: Option<f64>,
     /// The energy ratio of fretting maps, `W/(4Q*δ*)`: the friction work over the rectangle
     /// of the loop's amplitudes `Q* = (Q_max − Q_min)/2` and `δ* = (δ_max − δ_min)/2` (below
