@@ -130,3 +130,16 @@ def test_the_tutorial_runs(tmp_path):
     done = subprocess.run([sys.executable, script, figure], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
     assert figure.stat().st_size > 10_000
+
+
+def test_displacement_control_reaches_the_coulomb_plateau():
+    """The punch's displacement prescribed (`"unit": "metre"`) beyond gross slip on the
+    uncoupled cylinder: Q stops at ±ηP while δ goes on, the cycles are gross slip, and the
+    energy ratio W/(4Q*δ*) is the closed form's 0.5187 (Mindlin–Deresiewicz plus the
+    plateaus; the Rust test `displacement_control_into_gross_slip_...` derives it)."""
+    result = fretsim.run(SCENARIOS / "displacement_gross_slip.json")
+    ratio = result.steps["Q_over_etaP"]
+    assert np.max(np.abs(ratio)) == pytest.approx(1.0, abs=1e-10)
+    assert np.sum(np.abs(np.abs(ratio) - 1.0) < 1e-10) > 100
+    assert list(result.cycles["regime"]) == ["gross_slip"] * len(result.cycles["regime"])
+    assert result.cycles["energy_ratio"][1] == pytest.approx(0.5187, abs=1e-3)
