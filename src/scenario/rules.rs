@@ -328,27 +328,21 @@ pub(super) fn resolve_history(
 ) -> CheckedHistory {
     let limit = friction * normal_load;
     let columns = history_columns(issues, h, electric);
-    let scale = match h.unit {
-        LoadUnit::FractionOfLimit => limit,
-        LoadUnit::NewtonPerMetre => 1.0,
-        LoadUnit::Metre => f64::NAN,
-    };
     // Q of a point in N/m (a fraction of η times the point's own P), or δ in m.
     let q_of = |p: &[f64]| match h.unit {
         LoadUnit::FractionOfLimit => column(p, 1, 0.0) * (friction * column(p, 2, normal_load)),
         LoadUnit::NewtonPerMetre | LoadUnit::Metre => column(p, 1, 0.0),
     };
-    // Under a prescribed displacement `max_step` bounds |Δδ| (m), and η|ΔP| keeps its default.
+    // `max_step` in the unit of Q; under a prescribed displacement it bounds |Δδ| (m), and
+    // η|ΔP| keeps its default.
+    let load_step = |scale: f64| h.max_step.map_or(0.05 * limit, |m| m * scale);
     let (control, max_step, max_displacement_step) = match h.unit {
+        LoadUnit::FractionOfLimit => (Control::Load, load_step(limit), f64::INFINITY),
+        LoadUnit::NewtonPerMetre => (Control::Load, load_step(1.0), f64::INFINITY),
         LoadUnit::Metre => (
             Control::Displacement,
             0.05 * limit,
             h.max_step.unwrap_or(f64::INFINITY),
-        ),
-        _ => (
-            Control::Load,
-            h.max_step.map_or(0.05 * limit, |m| m * scale),
-            f64::INFINITY,
         ),
     };
     // The tangential value of a point on the scale of `max_step`: Q (N/m), or δ in units of
