@@ -87,25 +87,27 @@ pub enum Verdict {
     NoCycles,
 }
 
-/// Split the records into cycles (positive extreme to positive extreme) and judge them.
+/// Split the records into cycles (positive extreme to positive extreme) and judge them. The
+/// history's last record is a positive extreme when it ends a forward phase that returns to the
+/// load of the one before ([`returns_to`]); a stretch after the last cycle is not a row.
 pub fn analyse_cycles(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>, Verdict) {
     // Positive extremes: last step of a forward phase followed by a reverse phase.
-    let maxima: Vec<usize> = (1..records.len().saturating_sub(1))
+    let load_scale = records.iter().map(|r| r.q.abs()).fold(0.0, f64::max);
+    let mut maxima: Vec<usize> = (1..records.len().saturating_sub(1))
         .filter(|&i| {
             records[i].regime == crate::history::Regime::ForwardSlip
                 && records[i + 1].regime == crate::history::Regime::ReverseSlip
         })
-        .chain(
-            (records.len() > 1
-                && records
-                    .last()
-                    .is_some_and(|r| r.regime == crate::history::Regime::ForwardSlip))
-            // Lazily: with no records `len() − 1` overflows (a panic in a debug build).
-            .then(|| records.len() - 1),
-        )
         .collect();
+    if let [_, .., last] = records
+        && last.regime == crate::history::Regime::ForwardSlip
+        && maxima
+            .last()
+            .is_none_or(|&m| returns_to(last, &records[m], load_scale))
+    {
+        maxima.push(records.len() - 1);
+    }
     let mut rows: Vec<CycleRow> = Vec::new();
-    let load_scale = records.iter().map(|r| r.q.abs()).fold(0.0, f64::max);
     for (k, w) in maxima.windows(2).enumerate() {
         let seg = &records[w[0]..=w[1]];
         let area = seg
@@ -407,11 +409,16 @@ impl CycleAnalysis {
         repeating > 0 && repeating >= period
     }
 
-    /// The rows and the verdict, the last record closing a cycle when it ends a forward phase.
+    /// The rows and the verdict, the last record closing a cycle when it ends a forward phase
+    /// that returns to the cycle's starting load ([`returns_to`]).
     pub fn finish(mut self, tolerance: f64) -> (Vec<CycleRow>, Verdict) {
         if let Some(last) = self.previous.take()
             && self.several
             && last.regime == crate::history::Regime::ForwardSlip
+            && self
+                .open
+                .as_ref()
+                .is_none_or(|open| returns_to(&last, &open.first, self.load_scale))
         {
             self.close_at(&last);
         }
@@ -439,6 +446,14 @@ fn compare_with_earlier(rows: &[CycleRow], row: &mut CycleRow, half_width: f64, 
         row.change = Some(change_against(prev, row, half_width));
         row.compared_with = Some(prev.cycle);
     }
+}
+
+/// Whether the history's last record `last`, at the end of a forward phase, closes the cycle
+/// that began at the positive extreme `start`: its Q reaches the start's (within 1e−9 of
+/// `load_scale`). A history that ends part of the way up (at Q = 0 after its last reversal,
+/// say) leaves that stretch open, as one that ends in a reverse phase does: not a cycle.
+fn returns_to(last: &StepRecord, start: &StepRecord, load_scale: f64) -> bool {
+    last.q >= start.q - 1e-9 * load_scale
 }
 
 /// Whether two cycles have the same loads (start, minimum, end of Q) within 1e−9 of
@@ -558,5 +573,48 @@ mod tests {
                 "first {n} records"
             );
         }
+    }
+
+    /// A steady Cattaneo–Mindlin cycle (uncoupled ν = 0.5, ±0.5 ηP) run three times and then
+    /// loaded part of the way up, to Q = 0: the stretch after the last positive extreme is not
+    /// a cycle, so the rows are the two full cycles and the verdict is steady cyclic slip (an
+    /// open third row, compared with nothing, left it not settled). Loaded on to +0.5 ηP, the
+    /// third cycle closes.
+    #[test]
+    fn a_history_ending_part_of_the_way_up_leaves_its_last_stretch_out_of_the_cycles() {
+        let records = |end: &str| {
+            let text = format!(
+                r#"{{
+                  "name": "open_end",
+                  "material": {{ "kind": "elastic", "shear_modulus": 27.3e9, "poisson_ratio": 0.5 }},
+                  "punch": {{ "radius": 0.01 }},
+                  "friction": 0.3,
+                  "normal_load": 2240.0,
+                  "tangential_history": {{
+                    "unit": "fraction_of_limit",
+                    "points": [[0.0, 0.0], [1.0, 0.5], [2.0, -0.5], [3.0, 0.5], [4.0, -0.5],
+                               [5.0, 0.5], [6.0, -0.5], {end}],
+                    "steps_per_segment": 8
+                  }}
+                }}"#
+            );
+            let raw = crate::scenario::parse(&text, std::path::Path::new("open_end")).unwrap();
+            let scenario = crate::scenario::validate(raw).unwrap();
+            crate::io::solve(&scenario, &mut NoObserver)
+                .unwrap()
+                .records
+        };
+        let open = records("[7.0, 0.0]");
+        let (rows, verdict) = analyse_cycles(&open, 1e-6);
+        assert_eq!(rows.len(), 2);
+        let at_5 = open.iter().find(|r| (r.t - 5.0).abs() < 1e-12).unwrap();
+        assert_eq!(rows[1].steps.1, at_5.step, "the last row ends at t = 5");
+        assert_eq!(verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 });
+        assert_eq!(incremental(&open, 1e-6).0.len(), 2);
+        let closed = records("[7.0, 0.0], [7.5, 0.5]");
+        let (rows, verdict) = analyse_cycles(&closed, 1e-6);
+        assert_eq!(rows.len(), 3);
+        assert_eq!(rows[2].steps.1, closed.last().unwrap().step);
+        assert_eq!(verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 });
     }
 }
