@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 
-use crate::history::StepRecord;
+use crate::history::{Control, StepRecord};
 
 /// One fretting cycle: from a positive extreme of Q to the next.
 #[derive(Debug, Clone, Serialize)]
@@ -87,12 +87,19 @@ pub enum Verdict {
     NoCycles,
 }
 
-/// Split the records into cycles (positive extreme to positive extreme) and judge them. The
-/// history's last record is a positive extreme when it ends a forward phase that returns to the
-/// load of the one before ([`returns_to`]); a stretch after the last cycle is not a row.
-pub fn analyse_cycles(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>, Verdict) {
+/// Split the records of a history under `control` into cycles (positive extreme to positive
+/// extreme) and judge them. The history's last record is a positive extreme when it ends a
+/// forward phase that returns to where the cycle began ([`Scales::returns_to`]); a stretch
+/// after the last cycle is not a row.
+pub fn analyse_cycles(
+    records: &[StepRecord],
+    control: Control,
+    tolerance: f64,
+) -> (Vec<CycleRow>, Verdict) {
     // Positive extremes: last step of a forward phase followed by a reverse phase.
-    let load_scale = records.iter().map(|r| r.q.abs()).fold(0.0, f64::max);
+    let mut scales = Scales::new(control);
+    records.iter().for_each(|r| scales.add(r));
+    let load_scale = scales.load;
     let mut maxima: Vec<usize> = (1..records.len().saturating_sub(1))
         .filter(|&i| {
             records[i].regime == crate::history::Regime::ForwardSlip
@@ -103,7 +110,7 @@ pub fn analyse_cycles(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>,
         && last.regime == crate::history::Regime::ForwardSlip
         && maxima
             .last()
-            .is_none_or(|&m| returns_to(last, &records[m], load_scale))
+            .is_none_or(|&m| scales.returns_to(last, &records[m]))
     {
         maxima.push(records.len() - 1);
     }
@@ -252,8 +259,47 @@ pub struct CycleAnalysis {
     several: bool,
     /// The cycle under way, from the last positive extreme.
     open: Option<OpenCycle>,
-    /// The largest |Q| so far.
-    load_scale: f64,
+    /// The largest |Q| and |δ| so far, and what drives the history.
+    scales: Scales,
+}
+
+/// The largest |Q| and |δ| of the records so far, and the history's control: the scales of
+/// the analysis's comparisons.
+#[derive(Debug, Clone, Copy, Default)]
+struct Scales {
+    control: Control,
+    load: f64,
+    displacement: f64,
+}
+
+impl Scales {
+    fn new(control: Control) -> Self {
+        Self {
+            control,
+            ..Self::default()
+        }
+    }
+
+    fn add(&mut self, record: &StepRecord) {
+        self.load = f64::max(self.load, record.q.abs());
+        self.displacement = f64::max(self.displacement, record.displacement.abs());
+    }
+
+    /// Whether the history's last record `last`, at the end of a forward phase, closes the
+    /// cycle that began at the positive extreme `start`: the prescribed quantity (Q under load
+    /// control, δ under displacement control) reaches the start's, within 1e−9 of its largest
+    /// magnitude. A history that ends part of the way up (at Q = 0 after its last reversal,
+    /// say) leaves that stretch open, as one that ends in a reverse phase does: not a cycle.
+    /// (Under displacement control Q says nothing: on the gross-slip plateau it is back at
+    /// ηP long before δ returns.)
+    fn returns_to(&self, last: &StepRecord, start: &StepRecord) -> bool {
+        match self.control {
+            Control::Load => last.q >= start.q - 1e-9 * self.load,
+            Control::Displacement => {
+                last.displacement >= start.displacement - 1e-9 * self.displacement
+            }
+        }
+    }
 }
 
 /// A cycle under way: its first record, the sums so far and its least Q.
@@ -331,15 +377,18 @@ impl OpenCycle {
 }
 
 impl CycleAnalysis {
-    /// An analysis with no records yet.
-    pub fn new() -> Self {
-        Self::default()
+    /// An analysis of a history under `control`, with no records yet.
+    pub fn new(control: Control) -> Self {
+        Self {
+            scales: Scales::new(control),
+            ..Self::default()
+        }
     }
 
     /// Take the next record.
     pub fn push(&mut self, record: &StepRecord) {
         use crate::history::Regime;
-        self.load_scale = f64::max(self.load_scale, record.q.abs());
+        self.scales.add(record);
         if let Some(previous) = self.previous.take() {
             // The previous record is a positive extreme when a reverse phase follows its
             // forward phase (record 0, the end of normal loading, never is).
@@ -379,7 +428,7 @@ impl CycleAnalysis {
     /// under a repeated variable-amplitude block). A run may stop there
     /// (`numerics.stop_when_settled`).
     pub fn settled(&self, tolerance: f64) -> bool {
-        let (rows, scale) = (&self.rows, self.load_scale);
+        let (rows, scale) = (&self.rows, self.scales.load);
         let n = rows.len();
         let no_slip = |r: &CycleRow| {
             let amp = (r.displacement_extremes.0 - r.displacement_extremes.1).abs();
@@ -410,7 +459,7 @@ impl CycleAnalysis {
     }
 
     /// The rows and the verdict, the last record closing a cycle when it ends a forward phase
-    /// that returns to the cycle's starting load ([`returns_to`]).
+    /// that returns to where the cycle began ([`Scales::returns_to`]).
     pub fn finish(mut self, tolerance: f64) -> (Vec<CycleRow>, Verdict) {
         if let Some(last) = self.previous.take()
             && self.several
@@ -418,17 +467,17 @@ impl CycleAnalysis {
             && self
                 .open
                 .as_ref()
-                .is_none_or(|open| returns_to(&last, &open.first, self.load_scale))
+                .is_none_or(|open| self.scales.returns_to(&last, &open.first))
         {
             self.close_at(&last);
         }
         let mut rows: Vec<CycleRow> = Vec::with_capacity(self.rows.len());
         for (mut row, half_width) in self.rows {
-            compare_with_earlier(&rows, &mut row, half_width, self.load_scale);
+            compare_with_earlier(&rows, &mut row, half_width, self.scales.load);
             rows.push(row);
         }
-        mark_no_slip(&mut rows, self.load_scale, tolerance);
-        let verdict = judge(&rows, self.load_scale, tolerance);
+        mark_no_slip(&mut rows, self.scales.load, tolerance);
+        let verdict = judge(&rows, self.scales.load, tolerance);
         (rows, verdict)
     }
 }
@@ -446,14 +495,6 @@ fn compare_with_earlier(rows: &[CycleRow], row: &mut CycleRow, half_width: f64, 
         row.change = Some(change_against(prev, row, half_width));
         row.compared_with = Some(prev.cycle);
     }
-}
-
-/// Whether the history's last record `last`, at the end of a forward phase, closes the cycle
-/// that began at the positive extreme `start`: its Q reaches the start's (within 1e−9 of
-/// `load_scale`). A history that ends part of the way up (at Q = 0 after its last reversal,
-/// say) leaves that stretch open, as one that ends in a reverse phase does: not a cycle.
-fn returns_to(last: &StepRecord, start: &StepRecord, load_scale: f64) -> bool {
-    last.q >= start.q - 1e-9 * load_scale
 }
 
 /// Whether two cycles have the same loads (start, minimum, end of Q) within 1e−9 of
@@ -515,7 +556,7 @@ mod tests {
     use crate::history::NoObserver;
 
     /// The records of every scenario in `scenarios/` with a history, and of the default one.
-    fn scenario_records() -> Vec<(String, Vec<StepRecord>, f64)> {
+    fn scenario_records() -> Vec<(String, Vec<StepRecord>, Control, f64)> {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
         let mut paths: Vec<_> = std::fs::read_dir(dir)
             .unwrap()
@@ -533,14 +574,19 @@ mod tests {
                 (
                     s.name.clone(),
                     solution.records,
+                    s.history.as_ref().map_or(Control::Load, |h| h.control),
                     s.raw.numerics.cycle_tolerance,
                 )
             })
             .collect()
     }
 
-    fn incremental(records: &[StepRecord], tolerance: f64) -> (Vec<CycleRow>, Verdict) {
-        let mut analysis = CycleAnalysis::new();
+    fn incremental(
+        records: &[StepRecord],
+        control: Control,
+        tolerance: f64,
+    ) -> (Vec<CycleRow>, Verdict) {
+        let mut analysis = CycleAnalysis::new(control);
         records.iter().for_each(|r| analysis.push(r));
         analysis.finish(tolerance)
     }
@@ -554,22 +600,22 @@ mod tests {
         let json = |x: &(Vec<CycleRow>, Verdict)| serde_json::to_string(x).unwrap();
         let all = scenario_records();
         let mut cycles = 0;
-        for (name, records, tolerance) in &all {
-            let batch = analyse_cycles(records, *tolerance);
+        for (name, records, control, tolerance) in &all {
+            let batch = analyse_cycles(records, *control, *tolerance);
             cycles += batch.0.len();
             assert_eq!(
-                json(&incremental(records, *tolerance)),
+                json(&incremental(records, *control, *tolerance)),
                 json(&batch),
                 "{name}"
             );
         }
         assert!(cycles >= 20, "{cycles} cycles compared");
-        let (_, default, tolerance) = all.last().unwrap();
+        let (_, default, control, tolerance) = all.last().unwrap();
         for n in 0..=default.len() {
             let prefix = &default[..n];
             assert_eq!(
-                json(&incremental(prefix, *tolerance)),
-                json(&analyse_cycles(prefix, *tolerance)),
+                json(&incremental(prefix, *control, *tolerance)),
+                json(&analyse_cycles(prefix, *control, *tolerance)),
                 "first {n} records"
             );
         }
@@ -605,16 +651,53 @@ mod tests {
                 .records
         };
         let open = records("[7.0, 0.0]");
-        let (rows, verdict) = analyse_cycles(&open, 1e-6);
+        let (rows, verdict) = analyse_cycles(&open, Control::Load, 1e-6);
         assert_eq!(rows.len(), 2);
         let at_5 = open.iter().find(|r| (r.t - 5.0).abs() < 1e-12).unwrap();
         assert_eq!(rows[1].steps.1, at_5.step, "the last row ends at t = 5");
         assert_eq!(verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 });
-        assert_eq!(incremental(&open, 1e-6).0.len(), 2);
+        assert_eq!(incremental(&open, Control::Load, 1e-6).0.len(), 2);
         let closed = records("[7.0, 0.0], [7.5, 0.5]");
-        let (rows, verdict) = analyse_cycles(&closed, 1e-6);
+        let (rows, verdict) = analyse_cycles(&closed, Control::Load, 1e-6);
         assert_eq!(rows.len(), 3);
         assert_eq!(rows[2].steps.1, closed.last().unwrap().step);
         assert_eq!(verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 });
+    }
+
+    /// Under displacement control a cycle closes when δ returns, not Q: the gross-slip history
+    /// of `scenarios/displacement_gross_slip.json` at η = 0.1 (δ_g a third of the amplitude)
+    /// ends at δ = 0 on its way up, where Q is already back on the +ηP plateau. Its rows are
+    /// the two full cycles, each spanning the whole δ range ±60 nm with an energy ratio below 1
+    /// (the trailing stretch, taken as a cycle, spanned half the range with a ratio of 1.35).
+    #[test]
+    fn under_displacement_control_a_cycle_closes_when_the_displacement_returns() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/displacement_gross_slip.json");
+        let text = std::fs::read_to_string(&path)
+            .unwrap()
+            .replace("\"friction\": 0.3", "\"friction\": 0.1");
+        let scenario =
+            crate::scenario::validate(crate::scenario::parse(&text, &path).unwrap()).unwrap();
+        let records = crate::io::solve(&scenario, &mut NoObserver)
+            .unwrap()
+            .records;
+        let last = records.last().unwrap();
+        assert!(last.displacement.abs() < 1e-15 && last.q > 0.999 * 0.1 * 2240.0);
+        let (rows, verdict) = analyse_cycles(&records, Control::Displacement, 1e-6);
+        assert_eq!(rows.len(), 2);
+        for r in &rows {
+            let range = r.displacement_extremes.0 - r.displacement_extremes.1;
+            assert!((range - 1.2e-7).abs() < 1e-15, "δ range {range}");
+            assert_eq!(r.regime, CycleRegime::GrossSlip);
+            let ratio = r.energy_ratio.unwrap();
+            assert!(ratio > 0.5 && ratio < 1.0, "energy ratio {ratio}");
+        }
+        assert_eq!(verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 });
+        let by_load = analyse_cycles(&records, Control::Load, 1e-6).0;
+        assert_eq!(
+            by_load.len(),
+            3,
+            "Q alone takes the trailing stretch for a cycle"
+        );
     }
 }

@@ -249,7 +249,12 @@ impl Digest {
         };
         Ok(Self {
             tally: RecordTally::new(SlipOptions::default().tolerance),
-            cycles: CycleAnalysis::new(),
+            cycles: CycleAnalysis::new(
+                scenario
+                    .history
+                    .as_ref()
+                    .map_or(crate::history::Control::Load, |h| h.control),
+            ),
             plots: PlotWindow::new(q_scale),
             steps,
             error: None,
@@ -880,7 +885,9 @@ mod tests {
             let read = |name: &str| std::fs::read(out.join(name)).unwrap();
             assert!(read("steps.csv") == crate::io::csv::steps_table(&memory.records, friction).csv());
             let tolerance = scenario.raw.numerics.cycle_tolerance;
-            let (cycles, verdict) = crate::analysis::analyse_cycles(&memory.records, tolerance);
+            let control = scenario.history.as_ref().unwrap().control;
+            let (cycles, verdict) =
+                crate::analysis::analyse_cycles(&memory.records, control, tolerance);
             assert!(read("cycles.csv") == cycles_table(&cycles).csv());
             let summary = serde_json::to_vec_pretty(&memory.summary).unwrap();
             assert!(read("summary.json") == summary);

@@ -379,8 +379,8 @@ pub(crate) struct VariantOutcome {
 }
 
 /// A variant's history in `sweep.csv` (sweeps with runs): steps, cycles, the verdict, the
-/// last full cycle's friction work and displacement amplitude, and the steps the general
-/// solver took.
+/// last full cycle's friction work, displacement amplitude, regime, slip amplitude and energy
+/// ratio ([`crate::analysis::CycleRow`]), and the steps the general solver took.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct HistoryColumns {
     steps: usize,
@@ -388,16 +388,23 @@ pub(crate) struct HistoryColumns {
     verdict: String,
     friction_work: f64,
     displacement_amplitude: f64,
+    /// The last cycle's regime (`partial_slip`, `gross_slip`, `no_slip`; empty without one).
+    regime: String,
+    slip_amplitude: f64,
+    energy_ratio: f64,
     general_steps: usize,
 }
 
 impl HistoryColumns {
-    const HEADER: [&'static str; 6] = [
+    const HEADER: [&'static str; 9] = [
         "steps",
         "cycles",
         "verdict",
         "friction_work_last_cycle_J_per_m",
         "delta_amplitude_last_cycle_m",
+        "regime_last_cycle",
+        "slip_amplitude_last_cycle_m",
+        "energy_ratio_last_cycle",
         "general_steps",
     ];
 
@@ -416,6 +423,12 @@ impl HistoryColumns {
             displacement_amplitude: last.map_or(f64::NAN, |c| {
                 0.5 * (c.displacement_extremes.0 - c.displacement_extremes.1)
             }),
+            regime: last
+                .and_then(|c| serde_json::to_value(c.regime).ok())
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default(),
+            slip_amplitude: last.and_then(|c| c.slip_amplitude).unwrap_or(f64::NAN),
+            energy_ratio: last.and_then(|c| c.energy_ratio).unwrap_or(f64::NAN),
             general_steps: summary.solver.general_steps,
         })
     }
@@ -428,6 +441,9 @@ impl HistoryColumns {
                 h.verdict.clone(),
                 format!("{:.10e}", h.friction_work),
                 format!("{:.10e}", h.displacement_amplitude),
+                h.regime.clone(),
+                format!("{:.10e}", h.slip_amplitude),
+                format!("{:.10e}", h.energy_ratio),
                 h.general_steps.to_string(),
             ],
             None => vec![String::new(); Self::HEADER.len()],
@@ -619,7 +635,7 @@ fn result_columns(outcomes: &[VariantOutcome], runs: bool) -> Vec<ResultColumn> 
         .collect();
     if runs {
         type History = fn(&HistoryColumns) -> f64;
-        let history: [(&str, &str, History); 5] = [
+        let history: [(&str, &str, History); 7] = [
             ("steps", "steps (–)", |h| h.steps as f64),
             ("cycles", "cycles (–)", |h| h.cycles as f64),
             (
@@ -631,6 +647,16 @@ fn result_columns(outcomes: &[VariantOutcome], runs: bool) -> Vec<ResultColumn> 
                 "delta_amplitude_last_cycle_m",
                 "δ amplitude of the last cycle (m)",
                 |h| h.displacement_amplitude,
+            ),
+            (
+                "slip_amplitude_last_cycle_m",
+                "slip amplitude of the last cycle (m)",
+                |h| h.slip_amplitude,
+            ),
+            (
+                "energy_ratio_last_cycle",
+                "energy ratio W/(4Q*δ*) of the last cycle (–)",
+                |h| h.energy_ratio,
             ),
             ("general_steps", "steps of the general solver (–)", |h| {
                 h.general_steps as f64
@@ -677,22 +703,33 @@ pub(crate) fn write_pages(
     let fields: Vec<&str> = vary.iter().map(|v| v.path.as_str()).collect();
     let axes: Vec<Vec<f64>> = vary.iter().map(|v| v.values.clone()).collect();
     let values: Vec<Vec<f64>> = scenarios.iter().map(|(_, v, _)| v.clone()).collect();
-    let verdicts: Option<Vec<String>> = runs.then(|| {
+    // The categorical results (sweeps with runs): the verdict, and the last cycle's regime
+    // (with the energy ratio's map beside it: a fretting map).
+    let category = |of: fn(&HistoryColumns) -> &str| -> Vec<String> {
         outcomes
             .iter()
             .map(|o| match (&o.error, &o.history) {
                 (Some(_), _) => "failed".to_string(),
-                (None, Some(h)) => h.verdict.clone(),
+                (None, Some(h)) if of(h).is_empty() => "no cycles".to_string(),
+                (None, Some(h)) => of(h).to_string(),
                 (None, None) => "no history".to_string(),
             })
             .collect()
-    });
+    };
+    let categories: Vec<(&str, Vec<String>)> = if runs {
+        vec![
+            ("verdict", category(|h| &h.verdict)),
+            ("regime", category(|h| &h.regime)),
+        ]
+    } else {
+        Vec::new()
+    };
     let results = sweep_plots(
         &fields,
         &axes,
         &values,
         &result_columns(outcomes, runs),
-        verdicts.as_deref(),
+        &categories,
     );
     let title = match fields.as_slice() {
         [f] => format!("Results against {f}"),

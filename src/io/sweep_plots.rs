@@ -1,7 +1,8 @@
 //! The plots of a sweep's scalar results (the numeric columns of `sweep.csv`): with one
 //! varied field each result against it; with two a map over the grid of the two fields, one
-//! per result, and, with runs, a map of the verdict (a fretting map: amplitude × load →
-//! regime). With three or more varied fields there are no result plots.
+//! per result, and, with runs, maps of the verdict and of the last cycle's regime (with the
+//! energy ratio's map: a fretting map, amplitude × load → regime). With three or more varied
+//! fields there are no result plots.
 
 use crate::io::svg::{Area, Figure, Note, Series};
 
@@ -185,7 +186,7 @@ fn value_map(grid: &Grid<'_>, r: &ResultColumn) -> String {
     figure.svg()
 }
 
-/// A map of a categorical result (the verdict) over the grid, one colour per category.
+/// A map of a categorical result (the verdict, the regime) over the grid, one colour per category.
 fn category_map(grid: &Grid<'_>, name: &str, categories: &[String]) -> String {
     let mut kinds: Vec<&str> = categories.iter().map(String::as_str).collect();
     kinds.sort_unstable();
@@ -214,14 +215,15 @@ fn category_map(grid: &Grid<'_>, name: &str, categories: &[String]) -> String {
 }
 
 /// The result plots of a sweep (module docs). `values` holds each variant's varied values,
-/// `verdicts` each variant's verdict (sweeps with runs; `failed` for a variant whose run
-/// stopped).
+/// `categories` the categorical results by name, one value per variant (sweeps with runs: the
+/// verdict and the last cycle's regime; `failed` for a variant whose run stopped), drawn as
+/// maps over two varied fields.
 pub(crate) fn sweep_plots(
     fields: &[&str],
     axes: &[Vec<f64>],
     values: &[Vec<f64>],
     results: &[ResultColumn],
-    verdicts: Option<&[String]>,
+    categories: &[(&str, Vec<String>)],
 ) -> Vec<(String, String)> {
     let results: Vec<&ResultColumn> = results
         .iter()
@@ -234,14 +236,13 @@ pub(crate) fn sweep_plots(
         }
         ([f0, f1], [a0, a1]) => {
             let grid = Grid::new([f0, f1], [a0, a1], values);
-            let mut plots: Vec<(String, String)> = results
+            let categorical = categories
                 .iter()
-                .map(|r| (format!("map_{}", r.name), value_map(&grid, r)))
-                .collect();
-            if let Some(v) = verdicts {
-                plots.insert(0, ("map_verdict".into(), category_map(&grid, "verdict", v)));
-            }
-            plots
+                .map(|(name, v)| (format!("map_{name}"), category_map(&grid, name, v)));
+            let numeric = results
+                .iter()
+                .map(|r| (format!("map_{}", r.name), value_map(&grid, r)));
+            categorical.chain(numeric).collect()
         }
         _ => Vec::new(),
     }
@@ -272,7 +273,7 @@ mod tests {
             &[vec![0.1, 0.2, 0.3]],
             &values,
             &results,
-            None,
+            &[],
         );
         assert_eq!(plots.len(), 1, "a column without values is not plotted");
         let (name, svg) = &plots[0];
@@ -295,9 +296,12 @@ mod tests {
             .take(6)
             .map(|s| s.to_string())
             .collect();
-        let plots = sweep_plots(&["a", "b"], &axes, &values, &results, Some(&verdicts));
+        let regimes = vec!["partial_slip".to_string(); 6];
+        let categories = [("verdict", verdicts), ("regime", regimes)];
+        let plots = sweep_plots(&["a", "b"], &axes, &values, &results, &categories);
         let names: Vec<&str> = plots.iter().map(|(n, _)| n.as_str()).collect();
-        assert_eq!(names, ["map_verdict", "map_b_over_a"]);
+        assert_eq!(names, ["map_verdict", "map_regime", "map_b_over_a"]);
+        assert!(plots[1].1.contains(">partial slip<"));
         let verdict = &plots[0].1;
         assert_eq!(verdict.matches(r#"class="area""#).count(), 6);
         assert!(verdict.contains("steady_cyclic_slip") && verdict.contains(">failed<"));
@@ -305,12 +309,12 @@ mod tests {
             verdict.contains(">steady cyclic slip<"),
             "each cell names its category"
         );
-        let map = &plots[1].1;
+        let map = &plots[2].1;
         assert_eq!(map.matches(r#"class="area""#).count(), 6);
         assert!(map.contains(r##"fill="#440154""##), "least value dark");
         assert!(map.contains(r##"fill="#fde725""##), "greatest value yellow");
         assert!(!map.contains(r#"fill="""#));
-        assert!(sweep_plots(&["a", "b", "c"], &[], &values, &results, None).is_empty());
+        assert!(sweep_plots(&["a", "b", "c"], &[], &values, &results, &[]).is_empty());
     }
 
     #[test]

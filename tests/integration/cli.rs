@@ -627,6 +627,12 @@ fn scenario_displacement_gross_slip() {
     // The closed form, W_MD(ηP) + 4ηP(δ* − δ_g) over 4ηPδ*, is 0.5187 (test
     // `displacement_control_into_gross_slip_follows_mindlin_deresiewicz_and_the_coulomb_plateau`).
     assert!((energy[1] - 0.5187).abs() < 1e-3, "{energy:?}");
+    // The history ends at δ = 0 on its way up: two full cycles, the same one twice.
+    assert_eq!(cycles.len(), 2);
+    assert!(matches!(
+        s.history.as_ref().unwrap().verdict,
+        Verdict::SteadyCyclicSlip { from_cycle: 1 }
+    ));
     assert!(out.join("plots/hysteresis_slip.svg").is_file());
 }
 
@@ -1535,6 +1541,7 @@ fn sweep_over_two_fields_draws_maps() {
         let map = std::fs::read_to_string(out.join("plots/map_b_over_a.svg")).unwrap();
         assert_eq!(map.matches(r#"class="area""#).count(), 4);
         assert_eq!(out.join("plots/map_verdict.svg").exists(), runs);
+        assert_eq!(out.join("plots/map_regime.svg").exists(), runs);
         assert_eq!(out.join("plots/map_steps.svg").exists(), runs);
         // No full cycle in the short history: no map of the last cycle's friction work.
         assert!(
@@ -1723,8 +1730,8 @@ fn stalled_step_is_accepted_below_the_stall_tolerance_and_reported() {
 }
 
 /// `sweep --runs` reports each variant's history in `sweep.csv`: its steps and cycles, the
-/// verdict, and the last cycle's friction work and half range of δ, as its own `cycles.csv`
-/// and `summary.json` give them.
+/// verdict, and the last cycle's friction work, half range of δ, regime, slip amplitude and
+/// energy ratio, as its own `cycles.csv` and `summary.json` give them.
 #[test]
 fn sweep_with_runs_reports_each_variants_history() {
     let tmp = tempfile::tempdir().unwrap();
@@ -1763,6 +1770,32 @@ fn sweep_with_runs_reports_each_variants_history() {
         assert!((work - last[7]).abs() <= 1e-9 * last[7].abs());
         let amplitude: f64 = cells[col("delta_amplitude_last_cycle_m")].parse().unwrap();
         assert!((amplitude - 0.5 * (last[10] - last[11])).abs() <= 1e-9 * amplitude.abs());
+        let (cycles_header, _) = read_csv(&dir.join("cycles.csv"));
+        let cycle_col = |name: &str| {
+            cycles_header
+                .split(',')
+                .position(|h| h == name)
+                .unwrap_or_else(|| panic!("{name} in cycles.csv"))
+        };
+        let cycles_text = std::fs::read_to_string(dir.join("cycles.csv")).unwrap();
+        let last_text: Vec<&str> = cycles_text.lines().last().unwrap().split(',').collect();
+        assert_eq!(
+            cells[col("regime_last_cycle")],
+            last_text[cycle_col("regime")]
+        );
+        assert_eq!(cells[col("regime_last_cycle")], "partial_slip");
+        for (sweep_name, cycles_name) in [
+            ("slip_amplitude_last_cycle_m", "slip_amplitude_m"),
+            ("energy_ratio_last_cycle", "energy_ratio"),
+        ] {
+            let value: f64 = cells[col(sweep_name)].parse().unwrap();
+            let expected = last[cycle_col(cycles_name)];
+            assert!(value > 0.0, "{sweep_name} {value}");
+            assert!(
+                (value - expected).abs() <= 1e-9 * expected.abs(),
+                "{sweep_name}: {value} against {expected}"
+            );
+        }
         let general: usize = cells[col("general_steps")].parse().unwrap();
         assert_eq!(general, s.solver.general_steps);
         assert_eq!(*header.last().unwrap(), "error");

@@ -999,6 +999,7 @@ fn reference_fretting_loop_uncoupled() {
 fn cycle_verdicts() {
     use fretsim::analysis::{Verdict, analyse_cycles};
     use fretsim::contact::normal::{NormalOptions, solve_normal};
+    use fretsim::history::Control;
     let Uncoupled { model, p_load, .. } = uncoupled();
     let lim = model.friction * p_load;
     let disc = Discretisation::new(32);
@@ -1011,7 +1012,7 @@ fn cycle_verdicts() {
         run_points(&model, &disc, &normal, pts, 10, lim).records
     };
     let steady = run(&[0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5]);
-    let (cycles, verdict) = analyse_cycles(&steady, 1e-6);
+    let (cycles, verdict) = analyse_cycles(&steady, Control::Load, 1e-6);
     assert_eq!(cycles.len(), 3);
     // Masing: the +½ state after virgin loading is already the cyclic one.
     assert_eq!(verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 });
@@ -1019,7 +1020,7 @@ fn cycle_verdicts() {
         assert_relative_eq!(c.friction_work, c.loop_area, max_relative = 1e-6);
     }
     let growing = run(&[0.3, 0.3, 0.3, 0.3, 0.3, 0.5, 0.5]);
-    let (_, verdict) = analyse_cycles(&growing, 1e-6);
+    let (_, verdict) = analyse_cycles(&growing, Control::Load, 1e-6);
     assert!(matches!(verdict, Verdict::NotSettled { .. }), "{verdict:?}");
 }
 
