@@ -191,13 +191,15 @@ fn category_map(grid: &Grid<'_>, name: &str, categories: &[String]) -> String {
     let mut kinds: Vec<&str> = categories.iter().map(String::as_str).collect();
     kinds.sort_unstable();
     kinds.dedup();
+    // In words, as in the cells: `gross slip`, not `gross_slip`.
+    let words: Vec<String> = kinds.iter().map(|k| k.replace('_', " ")).collect();
     let mut figure = grid.figure(
         format!("{name} over {} × {}", grid.fields[0], grid.fields[1]),
         String::new(),
     );
     for (k, c) in categories.iter().enumerate() {
         let i = kinds.iter().position(|x| x == c).unwrap_or(0);
-        let label = kinds[i];
+        let label = words[i].as_str();
         figure.areas.push(Area {
             points: grid.rectangle(k),
             fill: CATEGORY_COLOURS[i % CATEGORY_COLOURS.len()].into(),
@@ -304,11 +306,13 @@ mod tests {
         assert!(plots[1].1.contains(">partial slip<"));
         let verdict = &plots[0].1;
         assert_eq!(verdict.matches(r#"class="area""#).count(), 6);
-        assert!(verdict.contains("steady_cyclic_slip") && verdict.contains(">failed<"));
-        assert!(
-            verdict.contains(">steady cyclic slip<"),
-            "each cell names its category"
+        assert!(!verdict.contains("steady_cyclic_slip"), "in words");
+        assert_eq!(
+            verdict.matches(">steady cyclic slip<").count(),
+            4,
+            "each cell names its category, and the legend once"
         );
+        assert_eq!(verdict.matches(">failed<").count(), 4);
         let map = &plots[2].1;
         assert_eq!(map.matches(r#"class="area""#).count(), 6);
         assert!(map.contains(r##"fill="#440154""##), "least value dark");
