@@ -55,6 +55,7 @@
 //! valid on and off the contact (off it p = q = g = 0 and only the Cauchy terms remain).
 
 pub mod frictionless;
+mod gap_table;
 internal! { mod general; }
 pub mod memory;
 pub mod normal;
@@ -75,6 +76,7 @@ use serde::Serialize;
 use crate::error::MaterialFailure;
 use crate::halfplane::{SurfaceCompliance, SurfaceFieldCoefficients};
 use crate::material::Material;
+pub use gap_table::{GapTable, TableIssue};
 pub(crate) use inherited::smootherstep;
 pub use pressure::Discretisation;
 pub use profile::Profile;

@@ -28,14 +28,21 @@
 //!   `P = 2nA aⁿ W(n)/Y*` with Wallis's `W(n) = ∫₀^{π/2} sinⁿφ dφ`
 //!   ([`crate::analytical::power_law_half_width`]). The general solver takes it too.
 //!
+//! - A table of heights, `h(x)` through points `(x_i, h_i)` of one side of a symmetric punch
+//!   joined by Schumaker's convex, slope-continuous quadratic spline ([`GapTable`]): for a
+//!   measured or designed pad. Its frictionless load is the integral above in closed form on
+//!   each parabola. The general solver takes it.
+//!
 //! On an uncoupled half-plane the Cattaneo-type stick zone of a symmetric punch under Q from
 //! zero at constant P carries the load `P(c) = P − |Q|/η` of the same punch (Jäger's and
 //! Ciavarella's superposition): `c/a = (1 − |Q|/(ηP))^(1/n)` for the power law.
 
 use serde::{Deserialize, Serialize};
 
+use super::GapTable;
+
 /// A punch profile.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Profile {
     /// A circular cylinder of radius R (m), in its parabolic (small-slope) form.
@@ -56,6 +63,11 @@ pub enum Profile {
         coefficient: f64,
         /// n.
         exponent: f64,
+    },
+    /// A table of heights `[x, h]` (m) from the axis, joined by a convex spline.
+    Tabulated {
+        /// The points and their spline.
+        points: GapTable,
     },
 }
 
@@ -83,17 +95,18 @@ impl Profile {
         matches!(self, Self::Cylinder { .. })
     }
 
-    /// The half-width of the flat face (m; 0 but for the flat punch).
+    /// The half-width of the flat face (m; 0 but for the flat punch and a table with a flat).
     pub fn flat_half_width(&self) -> f64 {
-        match *self {
-            Self::FlatRounded { half_flat, .. } => half_flat,
+        match self {
+            Self::FlatRounded { half_flat, .. } => *half_flat,
+            Self::Tabulated { points } => points.flat_half_width(),
             _ => 0.0,
         }
     }
 
     /// The height h(x) of the surface above its lowest point at x from the axis (m).
     pub fn gap(&self, x: f64) -> f64 {
-        match *self {
+        match self {
             Self::Cylinder { radius } => x * x / (2.0 * radius),
             Self::FlatRounded { half_flat, radius } => {
                 let d = (x.abs() - half_flat).max(0.0);
@@ -102,7 +115,8 @@ impl Profile {
             Self::PowerLaw {
                 coefficient,
                 exponent,
-            } => coefficient * x.abs().powf(exponent),
+            } => coefficient * x.abs().powf(*exponent),
+            Self::Tabulated { points } => points.gap(x),
         }
     }
 
@@ -110,25 +124,25 @@ impl Profile {
     /// its width.
     pub fn gap_integral(&self, x1: f64, x2: f64) -> f64 {
         // Antiderivatives, odd in x.
-        let f = |x: f64| match *self {
-            Self::Cylinder { radius } => x.powi(3) / (6.0 * radius),
-            Self::FlatRounded { half_flat, radius } => {
+        let odd = |f: &dyn Fn(f64) -> f64| f(x2) - f(x1);
+        match self {
+            Self::Cylinder { radius } => (x2.powi(3) - x1.powi(3)) / (6.0 * radius),
+            Self::FlatRounded { half_flat, radius } => odd(&|x: f64| {
                 x.signum() * (x.abs() - half_flat).max(0.0).powi(3) / (6.0 * radius)
-            }
+            }),
             Self::PowerLaw {
                 coefficient,
                 exponent,
-            } => x.signum() * coefficient * x.abs().powf(exponent + 1.0) / (exponent + 1.0),
-        };
-        match *self {
-            Self::Cylinder { radius } => (x2.powi(3) - x1.powi(3)) / (6.0 * radius),
-            _ => f(x2) - f(x1),
+            } => odd(&|x: f64| {
+                x.signum() * coefficient * x.abs().powf(exponent + 1.0) / (exponent + 1.0)
+            }),
+            Self::Tabulated { points } => points.gap_integral(x1, x2),
         }
     }
 
     /// The slope h'(x) (–).
     pub fn slope(&self, x: f64) -> f64 {
-        match *self {
+        match self {
             Self::Cylinder { radius } => x / radius,
             Self::FlatRounded { half_flat, radius } => {
                 x.signum() * (x.abs() - half_flat).max(0.0) / radius
@@ -137,6 +151,7 @@ impl Profile {
                 coefficient,
                 exponent,
             } => x.signum() * coefficient * exponent * x.abs().powf(exponent - 1.0),
+            Self::Tabulated { points } => points.slope(x),
         }
     }
 
@@ -148,39 +163,45 @@ impl Profile {
 
     /// The curvature h'' (1/m): the cylinder's, constant, which the spectral solver relies on
     /// (the pressure then scales with one unit response of the collocation grid); the flat
-    /// punch's corners'; for the power law, `2A`, its value at n = 2 (the spectral solver never
-    /// takes these two; [`Self::frictionless_half_width`] is the general solver's guess).
+    /// punch's corners'; for the power law, `2A`, its value at n = 2; for a table, the tip's
+    /// (the spectral solver never takes these three; [`Self::frictionless_half_width`] is the
+    /// general solver's guess).
     pub fn curvature(&self) -> f64 {
         1.0 / self.radius()
     }
 
     /// 1/h'' of [`Self::curvature`] (m).
     fn radius(&self) -> f64 {
-        match *self {
-            Self::Cylinder { radius } | Self::FlatRounded { radius, .. } => radius,
+        match self {
+            Self::Cylinder { radius } | Self::FlatRounded { radius, .. } => *radius,
             Self::PowerLaw { coefficient, .. } => 1.0 / (2.0 * coefficient),
+            Self::Tabulated { points } => 1.0 / points.tip_curvature(),
         }
     }
 
     /// The frictionless contact half-width (m) under load P (N/m) on a half-plane of pressure
     /// compliance Y* (1/Pa): Hertz's for the cylinder, [`crate::analytical::FlatRounded`]'s
     /// for the flat punch, and for the power law, from `P = (1/Y*)∫ x h'(x)/√(a² − x²) dx`,
-    /// `P = 2nA aⁿ W(n)/Y*` with Wallis's integral `W(n) = ∫₀^{π/2} sinⁿφ dφ`.
+    /// `P = 2nA aⁿ W(n)/Y*` with Wallis's integral `W(n) = ∫₀^{π/2} sinⁿφ dφ`; for a table,
+    /// the root of its load ([`GapTable::frictionless_half_width`]).
     pub fn frictionless_half_width(&self, load: f64, compliance: f64) -> f64 {
-        match *self {
+        match self {
             Self::Cylinder { radius } => {
-                crate::analytical::Hertz::new(load, radius, compliance).half_width
+                crate::analytical::Hertz::new(load, *radius, compliance).half_width
             }
             Self::FlatRounded { half_flat, radius } => crate::analytical::FlatRounded {
-                half_flat,
-                radius,
+                half_flat: *half_flat,
+                radius: *radius,
                 compliance,
             }
             .half_width(load),
             Self::PowerLaw {
                 coefficient,
                 exponent,
-            } => crate::analytical::power_law_half_width(coefficient, exponent, load, compliance),
+            } => {
+                crate::analytical::power_law_half_width(*coefficient, *exponent, load, compliance)
+            }
+            Self::Tabulated { points } => points.frictionless_half_width(load, compliance),
         }
     }
 }

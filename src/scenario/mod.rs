@@ -286,6 +286,9 @@ fn build(
             }),
             _,
         ) => Profile::power_law(*coefficient, *exponent),
+        (Some(RawProfile::Tabulated { points }), _) => Profile::Tabulated {
+            points: crate::contact::GapTable::new(points.clone()).expect("validated table"),
+        },
         (None, radius) => Profile::cylinder(radius.expect("validated: a radius or a profile")),
     };
     let model = ContactModel::try_new(material, profile, raw.friction, electrode)
@@ -293,6 +296,18 @@ fn build(
         .with_reference_distance(raw.reference_distance)
         .with_coupling(raw.coupling)
         .with_stick_end_kinks(raw.numerics.stick_end_kinks);
+    if let Profile::Tabulated { points } = &model.profile {
+        let most = history
+            .as_ref()
+            .and_then(|h| h.punch.as_ref())
+            .map_or(0.0, |p| {
+                p.points.iter().map(|l| l.normal).fold(0.0, f64::max)
+            })
+            .max(raw.normal_load);
+        if let Some(issue) = rules::table_reach(points, most, model.compliance.y22) {
+            return Err(vec![issue]);
+        }
+    }
     let history = history.map(|mut h| {
         insert_snapshot_points(&mut h, &raw.output.snapshots, time_tolerance);
         h

@@ -304,6 +304,13 @@ pub enum RawProfile {
         /// n, ≥ 1 (a convex profile).
         exponent: f64,
     },
+    /// A table of heights of one side of a symmetric punch, `[x, h]` (m) from the axis
+    /// (x = 0 first, increasing), convex and slope-continuous, joined by a convex spline
+    /// ([`crate::contact::GapTable`]).
+    Tabulated {
+        /// `[x, h]` points (m), at least 3.
+        points: Vec<[f64; 2]>,
+    },
 }
 
 /// Electrode model.

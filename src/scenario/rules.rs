@@ -131,12 +131,12 @@ fn validate_profile(issues: &mut Vec<Issue>, raw: &RawScenario) {
         )),
         (None, Some(profile)) => {
             let at = |field: &str| format!("punch.profile.{field}");
-            let cylinder = match *profile {
+            let cylinder = match profile {
                 RawProfile::Cylinder { radius } => {
-                    positive(issues, &at("radius"), radius, "m");
+                    positive(issues, &at("radius"), *radius, "m");
                     true
                 }
-                RawProfile::FlatRounded {
+                &RawProfile::FlatRounded {
                     flat_half_width,
                     radius,
                 } => {
@@ -149,7 +149,7 @@ fn validate_profile(issues: &mut Vec<Issue>, raw: &RawScenario) {
                     }
                     flat_half_width == 0.0
                 }
-                RawProfile::PowerLaw {
+                &RawProfile::PowerLaw {
                     coefficient,
                     exponent,
                 } => {
@@ -164,6 +164,18 @@ fn validate_profile(issues: &mut Vec<Issue>, raw: &RawScenario) {
                     }
                     false
                 }
+                RawProfile::Tabulated { points } => {
+                    if let Err(issue) = crate::contact::GapTable::new(points.clone()) {
+                        issues.push(match issue.point {
+                            Some(i) => Issue::new(
+                                format!("punch.profile.points[{i}]"),
+                                format!("{:?} {}", points[i], issue.message),
+                            ),
+                            None => Issue::new(at("points"), issue.message),
+                        });
+                    }
+                    false
+                }
             };
             if !cylinder && raw.numerics.solver == crate::history::SolverChoice::Spectral {
                 issues.push(Issue::new(
@@ -173,6 +185,39 @@ fn validate_profile(issues: &mut Vec<Issue>, raw: &RawScenario) {
             }
         }
     }
+}
+
+/// The contact of a tabulated profile must lie well inside its table: the frictionless
+/// half-width under the largest P of the scenario, `a`, at most 0.8 of the last x (the
+/// friction, the coupling and Q move the ends by a few per cent of a), and the slope there
+/// small, at most 0.1 at 1.25 a (the half-plane's small-slope assumption). `compliance` is
+/// the larger pressure compliance `y22` (the wider contact).
+pub(super) fn table_reach(
+    table: &crate::contact::GapTable,
+    load: f64,
+    compliance: f64,
+) -> Option<Issue> {
+    let a = table.frictionless_half_width(load, compliance);
+    let extent = table.extent();
+    if a > 0.8 * extent {
+        return Some(Issue::new(
+            "punch.profile.points",
+            format!(
+                "a table to x = {extent:.4e} m is invalid for this contact: under P = {load} N/m its frictionless half-width is a = {a:.4e} m, and the table must reach at least 1.25 a = {:.4e} m",
+                1.25 * a
+            ),
+        ));
+    }
+    let slope = table.slope(1.25 * a);
+    (slope > 0.1).then(|| {
+        Issue::new(
+            "punch.profile.points",
+            format!(
+                "a table whose slope reaches {slope:.3} at 1.25 a = {:.4e} m is invalid; the half-plane solution needs small slopes, at most 0.1 over the contact",
+                1.25 * a
+            ),
+        )
+    })
 }
 
 /// Punch radius, loads, datum distance and friction.

@@ -175,6 +175,76 @@ fn punch_profile_rules() {
     );
 }
 
+/// A tabulated profile: its rules name the point (`punch.profile.points[i]`) and the rule; a
+/// table too short for the contact names the half-width it must reach; a table of a cylinder
+/// is refused by the spectral solver like any profile but the cylinder's formula.
+#[test]
+fn tabulated_profile_rules() {
+    let table = |points: &str, solver: &str| {
+        DEFAULT_SCENARIO
+            .replace(
+                "\"radius\": 0.06",
+                &format!("\"profile\": {{\"kind\": \"tabulated\", \"points\": {points}}}"),
+            )
+            .replace(
+                "\"friction\": 0.3",
+                &format!("\"friction\": 0.3, \"numerics\": {{\"solver\": \"{solver}\"}}"),
+            )
+    };
+    let messages =
+        |text: &str| -> Vec<String> { issues(text).iter().map(|i| i.to_string()).collect() };
+    assert_eq!(
+        messages(&table(
+            "[[0, 0], [1e-4, 1e-7], [2e-4, 2e-7], [3e-4, 4e-7]]",
+            "auto"
+        )),
+        [
+            "`punch.profile.points[0]` = [0.0, 0.0] is invalid; it is a corner of the profile (a straight run of slope 1.0000e-3 meets another slope there), and the profile must have a continuous slope (round the corner with more points)"
+        ]
+    );
+    let concave = messages(&table(
+        "[[0, 0], [1e-4, 1e-7], [2e-4, 4e-7], [3e-4, 5e-7]]",
+        "auto",
+    ));
+    assert_eq!(concave.len(), 1);
+    assert!(
+        concave[0].starts_with(
+            "`punch.profile.points[2]` = [0.0002, 4e-7] is invalid; it makes the profile concave"
+        ),
+        "{concave:?}"
+    );
+    assert_eq!(
+        messages(&table("[[0, 0], [1e-4, 1e-7]]", "auto")),
+        [
+            "`punch.profile.points` = 2 point(s) is invalid; a table needs at least 3 `[x, h]` points"
+        ]
+    );
+    // The default contact (P = 2000 N/m on PZT-4, R = 60 mm) has a ≈ 3.7e−5 m: a table of its
+    // cylinder to 4e−5 m is too short, to 2e−4 m long enough.
+    let cylinder = |extent: f64| {
+        let points: Vec<String> = (0..=20)
+            .map(|i| {
+                let x = extent * f64::from(i) / 20.0;
+                format!("[{x:e}, {:e}]", x * x / 0.12)
+            })
+            .collect();
+        format!("[{}]", points.join(", "))
+    };
+    let short = messages(&table(&cylinder(4e-5), "auto"));
+    assert_eq!(short.len(), 1);
+    assert!(
+        short[0].starts_with(
+            "`punch.profile.points` = a table to x = 4.0000e-5 m is invalid for this contact"
+        ) && short[0].contains("the table must reach at least 1.25 a"),
+        "{short:?}"
+    );
+    assert!(validate(parse(&table(&cylinder(2e-4), "auto"), Path::new("t")).unwrap()).is_ok());
+    assert_eq!(
+        issues(&table(&cylinder(2e-4), "spectral"))[0].path,
+        "numerics.solver"
+    );
+}
+
 #[test]
 fn electric_load_on_elastic_material_is_rejected() {
     let text = r#"{"material": {"kind": "elastic", "shear_modulus": 27.3e9, "poisson_ratio": 0.3},

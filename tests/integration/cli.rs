@@ -452,7 +452,7 @@ fn run_scenario(name: &str) -> (tempfile::TempDir, PathBuf, Summary) {
 }
 
 /// The scenarios with a test of their own below; a file in `scenarios/` without one fails.
-const SCENARIOS: [&str; 17] = [
+const SCENARIOS: [&str; 18] = [
     "baseline",
     "charge_history",
     "cattaneo_mindlin_uncoupled",
@@ -469,6 +469,7 @@ const SCENARIOS: [&str; 17] = [
     "partial_unload_reload",
     "small_friction_below_gamma1",
     "subsurface_map",
+    "tabulated_pad",
     "variable_amplitude",
 ];
 
@@ -688,6 +689,83 @@ fn scenario_flat_punch_fretting() {
         s.history.as_ref().unwrap().verdict,
         Verdict::SteadyCyclicSlip { from_cycle: 1 }
     );
+}
+
+/// The flat punch with rounded corners given as a table of heights (13 points, one at the
+/// end of the flat): the table's spline is that profile to round-off, so the run agrees with
+/// `flat_punch_fretting` (the same punch by formula) to 1e−9 in a and in the friction work of
+/// its last cycle, and with Ciavarella, Hills and Monno's a and c within the run's elements.
+#[test]
+fn scenario_tabulated_pad() {
+    let (_tmp, _out, s) = run_scenario("tabulated_pad");
+    let (_tmp2, _out2, by_formula) = run_scenario("flat_punch_fretting");
+    let n = &s.normal_loading;
+    assert_eq!(n.solver, "general");
+    let exact = fretsim::analytical::FlatRounded {
+        half_flat: 1e-5,
+        radius: 0.01,
+        compliance: s.derived.pressure_compliance,
+    };
+    let a = exact.half_width(2240.0);
+    assert!((n.half_width - a).abs() <= 5e-4 * a, "{} {a}", n.half_width);
+    assert!((n.half_width / by_formula.normal_loading.half_width - 1.0).abs() < 1e-9);
+    let c = exact.stick_half_width(2240.0, 0.3, 0.5 * 0.3 * 2240.0);
+    let snap = &s.snapshots[0];
+    assert!((snap.stick_hi - c).abs() <= 6e-3 * a && (snap.stick_lo + c).abs() <= 6e-3 * a);
+    let work = |s: &Summary| {
+        s.history
+            .as_ref()
+            .unwrap()
+            .cycles
+            .last()
+            .unwrap()
+            .friction_work
+    };
+    assert!((work(&s) / work(&by_formula) - 1.0).abs() < 1e-9);
+}
+
+/// A power-law punch `h = A|x|⁴` given as 41 unevenly spaced points (no parabola fits them):
+/// the contact half-width against `P = 2nA aⁿ W(n)/Y*` and, at Q = 0.5 ηP, the stick zone
+/// `c/a = (1 − Q/(ηP))^(1/4)`, within the elements (measured: Δa = −2.8e−4 a, Δc = −1.7e−3 a;
+/// the table's interpolation error is 5e−5 of h at its end).
+#[test]
+fn a_tabulated_power_law_punch_gives_the_power_laws_contact() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (coefficient, extent) = (1.25e11, 8e-5);
+    let points: Vec<[f64; 2]> = (0..=40)
+        .map(|i| {
+            let u = f64::from(i) / 40.0;
+            let x = extent * (0.6 * u + 0.4 * u * u);
+            [x, coefficient * x.powi(4)]
+        })
+        .collect();
+    let scenario = serde_json::json!({
+        "name": "power_table",
+        "material": { "kind": "elastic", "shear_modulus": 27.3e9, "poisson_ratio": 0.5 },
+        "punch": { "profile": { "kind": "tabulated", "points": points } },
+        "friction": 0.3,
+        "normal_load": 2240.0,
+        "tangential_history": {
+            "unit": "fraction_of_limit",
+            "points": [[0.0, 0.0], [1.0, 0.5]],
+            "steps_per_segment": 10
+        },
+        "output": { "snapshots": [1.0] }
+    });
+    let file = tmp.path().join("power_table.json");
+    std::fs::write(&file, scenario.to_string()).unwrap();
+    let (_tmp, _out, s) = run_checked(&file);
+    let y = s.derived.pressure_compliance;
+    let a = fretsim::analytical::power_law_half_width(coefficient, 4.0, 2240.0, y);
+    let n = &s.normal_loading;
+    let c = a * 0.5f64.powf(0.25);
+    let snap = &s.snapshots[0];
+    eprintln!(
+        "power-law table: a {:.6e} (exact {a:.6e}), stick [{:.6e}, {:.6e}] (exact ±{c:.6e})",
+        n.half_width, snap.stick_lo, snap.stick_hi
+    );
+    assert!((n.half_width - a).abs() <= 5e-4 * a, "{} {a}", n.half_width);
+    assert!((snap.stick_hi - c).abs() <= 6e-3 * a && (snap.stick_lo + c).abs() <= 6e-3 * a);
 }
 
 #[test]

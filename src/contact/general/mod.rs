@@ -277,7 +277,7 @@ pub(crate) enum ElectricControl {
 }
 
 /// The coefficients the element equations use.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Coefficients {
     pub y11: f64,
     pub y22: f64,
@@ -384,7 +384,7 @@ impl Solver {
             electric,
             coupled: model.coupling == Coupling::Full,
             friction: model.friction,
-            profile: model.profile,
+            profile: model.profile.clone(),
         };
         let influence = Influence::new(&mesh, model.reference_distance);
         Self {
