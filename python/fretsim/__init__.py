@@ -102,7 +102,11 @@ class Result:
     ``steps.csv``, ``cycles.csv`` and the field files (units in the names: ``Q_N_per_m``,
     ``x_m``, ``p_Pa``...) to numpy arrays; a missing value is NaN. ``fields`` is keyed by the
     field file's stem (``normal_loading``, ``t_2.000000``, ``step_00020``), ``labels`` gives
-    each one's legend. ``failure`` is the error that stopped the history part-way, or None.
+    each one's legend. ``subsurface`` holds, under ``output.subsurface``, the fields below the
+    surface at the same instants, by the same stems: the columns of ``subsurface/<stem>.csv``
+    (``x_m``, ``z_m``, ``sxx_Pa``, ``von_mises_Pa``...), one value per grid point, x
+    varying fastest (``reshape(nz, nx)`` gives a map). ``failure`` is the error that stopped
+    the history part-way, or None.
     """
 
     summary: Dict[str, Any]
@@ -110,6 +114,7 @@ class Result:
     cycles: Dict[str, np.ndarray]
     fields: Dict[str, Dict[str, np.ndarray]]
     labels: Dict[str, str] = field(default_factory=dict)
+    subsurface: Dict[str, Dict[str, np.ndarray]] = field(default_factory=dict)
     failure: Optional[str] = None
 
     @property
@@ -128,6 +133,7 @@ class Result:
             cycles=_table(raw["cycles"]),
             fields=fields,
             labels=labels,
+            subsurface={stem: _table(cols) for stem, cols in raw["subsurface"].items()},
             failure=raw["failure"],
         )
 

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use fretsim::error::Error;
-use fretsim::io::{Column, Table, cycles_table, fields_table, steps_table};
+use fretsim::io::{Column, Table, cycles_table, fields_table, steps_table, subsurface_table};
 use fretsim::scenario::{self, Scenario};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
@@ -99,25 +99,28 @@ fn table_dict<'py>(py: Python<'py>, table: &Table) -> PyResult<Bound<'py, PyDict
 }
 
 /// What a solved scenario gives Python: the summary (JSON), the step, cycle and field tables,
-/// and the failure that stopped the history, if any.
+/// the tables of the fields below the surface (`output.subsurface`) by the stem of their
+/// field file, and the failure that stopped the history, if any.
 struct Outcome {
     summary: String,
     steps: Table,
     cycles: Table,
     fields: Vec<(String, String, Table)>,
+    subsurface: Vec<(String, Table)>,
     failure: Option<String>,
 }
 
 fn outcome(scenario: &Scenario, solution: &fretsim::io::Solution) -> Outcome {
+    let all = || solution.fields.iter().chain(&solution.turning_fields);
     Outcome {
         summary: serde_json::to_string(&solution.summary).expect("a summary serialises"),
         steps: steps_table(&solution.records, scenario.model.friction),
         cycles: cycles_table(&solution.cycles),
-        fields: solution
-            .fields
-            .iter()
-            .chain(&solution.turning_fields)
+        fields: all()
             .map(|f| (f.stem.clone(), f.label.clone(), fields_table(&f.points)))
+            .collect(),
+        subsurface: all()
+            .filter_map(|f| Some((f.stem.clone(), subsurface_table(f.subsurface.as_ref()?))))
             .collect(),
         failure: solution.failure.as_ref().map(|e| e.to_string()),
     }
@@ -135,6 +138,11 @@ fn outcome_dict<'py>(py: Python<'py>, o: &Outcome) -> PyResult<Bound<'py, PyDict
         fields.set_item(stem, entry)?;
     }
     dict.set_item("fields", fields)?;
+    let subsurface = PyDict::new(py);
+    for (stem, table) in &o.subsurface {
+        subsurface.set_item(stem, table_dict(py, table)?)?;
+    }
+    dict.set_item("subsurface", subsurface)?;
     dict.set_item("failure", &o.failure)?;
     Ok(dict)
 }

@@ -49,6 +49,32 @@ def test_steps_and_fields_equal_the_command_lines_files(tmp_path):
     assert result.summary["history"]["verdict"] == summary["history"]["verdict"]
 
 
+def test_subsurface_maps_equal_the_command_lines_files(tmp_path):
+    """The fields below the surface (`output.subsurface`) of `fretsim.run`, by field stem, are
+    the command line's `subsurface/<stem>.csv` to their 10 digits, and reshape to (nz, nx)
+    maps with x along the rows; at z = 0 under normal loading σzz is −p, Hertz's pressure."""
+    scenario = SCENARIOS / "subsurface_map.json"
+    out = tmp_path / "cli"
+    subprocess.run([BINARY, "run", scenario, "--out", out, "--quiet"], check=True)
+    result = fretsim.run(scenario)
+    files = sorted(p.stem for p in (out / "subsurface").glob("*.csv"))
+    assert sorted(result.subsurface) == files and "normal_loading" in files
+    for stem in files:
+        header, rows = read_csv(out / "subsurface" / f"{stem}.csv")
+        assert list(result.subsurface[stem]) == header
+        for k, name in enumerate(header):
+            column = np.array([r[k] if r[k] else "nan" for r in rows], float)
+            np.testing.assert_allclose(result.subsurface[stem][name], column, rtol=1e-9)
+    table = result.subsurface["normal_loading"]
+    x = table["x_m"].reshape(41, 80)
+    z = table["z_m"].reshape(41, 80)
+    assert np.all(x == x[0]) and np.all(z.T == z[:, 0])
+    a = result.summary["normal_loading"]["half_width"]
+    p0 = result.summary["normal_loading"]["peak_pressure"]
+    hertz = p0 * np.sqrt(np.clip(1.0 - (x[0] / a) ** 2, 0.0, None))
+    np.testing.assert_allclose(table["szz_Pa"].reshape(41, 80)[0], -hertz, atol=1e-6 * p0)
+
+
 def test_cattaneo_mindlin_stick_zone_at_the_first_peak():
     """Uncoupled elastic contact (ν = 0.5): at the first peak Q = 0.6 ηP the stick zone is
     |x − c| ≤ a √(1 − Q/(ηP)) (Cattaneo–Mindlin)."""
