@@ -127,6 +127,7 @@ mod cache;
 pub mod cli;
 pub mod contact;
 pub mod error;
+pub mod fatigue;
 pub mod halfplane;
 pub mod history;
 pub mod io;
