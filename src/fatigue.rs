@@ -348,7 +348,8 @@ pub struct FatigueAnalysis {
     /// The cycle under way: its first step and the running extremes.
     open: Option<(usize, Vec<Running>)>,
     cycles: Vec<CycleSlip>,
-    last: Option<FatigueProfile>,
+    /// The indicators of the last two cycles closed, the later last.
+    last: Vec<FatigueProfile>,
 }
 
 impl FatigueAnalysis {
@@ -362,7 +363,7 @@ impl FatigueAnalysis {
             several: false,
             open: None,
             cycles: Vec::new(),
-            last: None,
+            last: Vec::new(),
         }
     }
 
@@ -410,15 +411,19 @@ impl FatigueAnalysis {
                 steps: profile.steps,
                 max_local_slip: profile.extreme(|p| p.slip_amplitude).value,
             });
-            self.last = Some(profile);
+            if self.last.len() == 2 {
+                self.last.remove(0);
+            }
+            self.last.push(profile);
         }
         let samples = &self.previous.as_ref().expect("a previous record").2;
         self.open = Some((extreme, samples.iter().map(Running::start).collect()));
     }
 
-    /// The cycles' largest local slip amplitudes and the indicators of the last cycle, the
-    /// last record closing a cycle when it ends a forward phase.
-    pub fn finish(mut self) -> (Vec<CycleSlip>, Option<FatigueProfile>) {
+    /// The cycles' largest local slip amplitudes and the indicators of the last two cycles
+    /// (the later last; a caller whose cycle analysis leaves a trailing cycle open takes the
+    /// one before), the last record closing a cycle when it ends a forward phase.
+    pub fn finish(mut self) -> (Vec<CycleSlip>, Vec<FatigueProfile>) {
         if let Some((Regime::ForwardSlip, step, _)) = &self.previous
             && self.several
         {
@@ -479,7 +484,7 @@ mod tests {
         let (cycles, last) = a.finish();
         assert_eq!(cycles.len(), 1);
         assert_eq!(cycles[0].steps, (1, 6));
-        let p = last.expect("a cycle").points[0];
+        let p = last.last().expect("a cycle").points[0];
         let close = |x: f64, y: f64| (x - y).abs() < 1e-15;
         assert!(close(p.slip_amplitude, 1.5), "{p:?}");
         assert!(close(cycles[0].max_local_slip, 1.5));

@@ -607,7 +607,7 @@ pub(crate) fn solve_from<'a>(
 
 /// The cycles' largest local slip amplitudes from `analysis` put into their rows (a cycle
 /// of the analysis is a row's when their first and last steps agree), and the indicators of
-/// the last cycle when it is the last row's.
+/// the last row's cycle.
 fn with_local_slip(analysis: FatigueAnalysis, rows: &mut [CycleRow]) -> Option<FatigueProfile> {
     let (slips, last) = analysis.finish();
     for row in rows.iter_mut() {
@@ -616,7 +616,8 @@ fn with_local_slip(analysis: FatigueAnalysis, rows: &mut [CycleRow]) -> Option<F
             .find(|s| s.steps == row.steps)
             .map(|s| s.max_local_slip);
     }
-    last.filter(|p| rows.last().is_some_and(|r| r.steps == p.steps))
+    let row = rows.last()?;
+    last.into_iter().rev().find(|p| p.steps == row.steps)
 }
 
 /// The rest of `history` after step `step`, from `state` after the steps `records` (all those

@@ -20,21 +20,13 @@
 use fretsim::analytical::mcewen;
 use fretsim::history::NoObserver;
 
-const SCENARIO: &str = r#"{
-  "name": "mindlin_deresiewicz_cycle",
-  "material": { "kind": "elastic", "shear_modulus": 27.3e9, "poisson_ratio": 0.5 },
-  "punch": { "radius": 0.01 },
-  "friction": 0.3,
-  "normal_load": 2240.0,
-  "tangential_history": {
-    "unit": "fraction_of_limit",
-    "points": [[0.0, 0.0], [1.0, 0.5]],
-    "cycle": [[2.0, -0.5], [4.0, 0.5]],
-    "repeats": 2,
-    "steps_per_segment": 20
-  },
-  "output": { "turning_point_fields": "none", "field_points": 800 }
-}"#;
+/// `scenarios/fretting_fatigue.json`: the cycle of the module docs, 20 steps a segment,
+/// 800 grid points.
+fn scenario_text() -> String {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/fretting_fatigue.json");
+    std::fs::read_to_string(path).unwrap()
+}
 
 struct Cycle {
     solution: fretsim::io::Solution,
@@ -47,7 +39,7 @@ struct Cycle {
 }
 
 fn steady_cycle() -> Cycle {
-    cycle_of(SCENARIO)
+    cycle_of(&scenario_text())
 }
 
 fn cycle_of(text: &str) -> Cycle {
@@ -203,7 +195,7 @@ fn ruiz_and_swt_maxima_from_the_closed_forms() {
 /// largest at the contact end.
 #[test]
 fn mindlin_deresiewicz_local_slip_amplitude_by_the_general_solver() {
-    let text = SCENARIO.replace(
+    let text = scenario_text().replace(
         r#""output""#,
         r#""numerics": { "solver": "general" }, "output""#,
     );
