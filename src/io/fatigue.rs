@@ -67,8 +67,8 @@ pub fn fatigue_table(profile: &FatigueProfile, electric: bool) -> Table {
     Table { columns }
 }
 
-/// `plots/fatigue`: δslip, σmax, Ruiz's F2 and SWT along x, each over its largest value
-/// (written in the legend).
+/// `plots/fatigue`: δslip, the tensile part of σmax, Ruiz's F2 and SWT along x, each over
+/// its largest value (written in the legend).
 pub fn fatigue_plot(profile: &FatigueProfile, scales: &PlotScales) -> (String, String) {
     let (length, x_label) = if scales.length > 0.0 {
         (
@@ -80,17 +80,14 @@ pub fn fatigue_plot(profile: &FatigueProfile, scales: &PlotScales) -> (String, S
     };
     type Curve = (&'static str, &'static str, fn(&crate::fatigue::PointIndicators) -> f64);
     let curves: [Curve; 4] = [
-        ("slip amplitude δslip", "m", |p| p.slip_amplitude),
-        ("σxx0 max", "Pa", |p| p.sigma_max),
-        ("Ruiz F2 = σmax·τ·δslip", "Pa·J/m²", |p| p.ruiz_f2),
-        ("SWT = σmax·Δε/2", "Pa", |p| p.swt),
+        ("δslip", "m", |p| p.slip_amplitude),
+        ("σmax⁺", "Pa", |p| p.sigma_max.max(0.0)),
+        ("Ruiz F2", "Pa·J/m²", |p| p.ruiz_f2),
+        ("SWT", "Pa", |p| p.swt),
     ];
     let labels: Vec<String> = curves
         .iter()
-        .map(|(name, unit, f)| {
-            let top = profile.extreme(f);
-            format!("{name} / {:.3e} {unit} (at x/a = {:.3})", top.value.abs(), top.x_over_a)
-        })
+        .map(|(name, unit, f)| format!("{name} ({:.3e} {unit})", profile.extreme(f).value))
         .collect();
     let series = curves
         .iter()
@@ -118,7 +115,8 @@ pub fn fatigue_plot(profile: &FatigueProfile, scales: &PlotScales) -> (String, S
         x_label,
         y_label: "indicator / its largest value".into(),
         series,
-        caption: "σmax, F2 and SWT take the tensile part of σxx0 (module crate::fatigue)".into(),
+        caption: "each over its largest value (legend); σmax⁺ = max(σmax, 0), which F2 and SWT use"
+            .into(),
         ..Figure::default()
     };
     ("fatigue".into(), figure.svg())
