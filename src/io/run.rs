@@ -926,7 +926,13 @@ mod tests {
             let read = |name: &str| std::fs::read(out.join(name)).unwrap();
             assert!(read("steps.csv") == crate::io::csv::steps_table(&memory.records, friction).csv());
             let tolerance = scenario.raw.numerics.cycle_tolerance;
-            let (cycles, verdict) = crate::analysis::analyse_cycles(&memory.records, tolerance);
+            let (mut cycles, verdict) = crate::analysis::analyse_cycles(&memory.records, tolerance);
+            // The largest local slip amplitudes need the states: those of the run in memory.
+            assert_eq!(cycles.len(), memory.cycles.len());
+            for (row, kept) in cycles.iter_mut().zip(&memory.cycles) {
+                row.max_local_slip = kept.max_local_slip;
+            }
+            assert!(memory.cycles.iter().all(|c| c.max_local_slip.is_some()));
             assert!(read("cycles.csv") == cycles_table(&cycles).csv());
             let summary = serde_json::to_vec_pretty(&memory.summary).unwrap();
             assert!(read("summary.json") == summary);
