@@ -47,6 +47,10 @@ pub struct CycleRow {
     /// of the loop's amplitudes `Q* = (Q_max − Q_min)/2` and `δ* = (δ_max − δ_min)/2` (below
     /// about 0.2 partial slip, towards 1 gross slip); `None` for a loop without amplitude.
     pub energy_ratio: Option<f64>,
+    /// The largest local slip amplitude δslip(x) over the field grid (m;
+    /// [`crate::fatigue`]), which needs the states and not only the records: `None` here, set
+    /// by the run from its [`crate::fatigue::FatigueAnalysis`].
+    pub max_local_slip: Option<f64>,
 }
 
 /// What a cycle's contact did.
@@ -149,6 +153,7 @@ pub fn analyse_cycles(
             regime: partial_or_gross(gross),
             slip_amplitude: slip.amplitude(),
             energy_ratio: energy_ratio(work, (hi_rec, lo_rec)),
+            max_local_slip: None,
         };
         compare_with_earlier(&rows, &mut row, hi_rec.half_width, load_scale);
         rows.push(row);
@@ -405,6 +410,7 @@ impl OpenCycle {
             regime: partial_or_gross(self.gross),
             slip_amplitude: self.slip.amplitude(),
             energy_ratio: energy_ratio(self.work, (hi_rec, lo_rec)),
+            max_local_slip: None,
         }
     }
 }

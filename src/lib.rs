@@ -76,6 +76,8 @@
 //!   [`analytical`]: closed-form oracles; [`halfplane`]: the surface compliance (extended
 //!   Stroh formalism), the paper's f_ij, Δ1…Δ4; [`subsurface`]: the stresses and electric
 //!   fields below the surface from p, q and g.
+//! - [`fatigue`]: surface fretting-fatigue indicators per cycle (local slip amplitude, σxx0
+//!   range, Ruiz's F1 and F2, Smith–Watson–Topper, the ranges of Dx0 and Ex).
 //! - [`io`]: solving a scenario and writing its output folder; [`cli`]: the command;
 //!   [`error`]: errors and their exit codes.
 //!
@@ -127,6 +129,7 @@ mod cache;
 pub mod cli;
 pub mod contact;
 pub mod error;
+pub mod fatigue;
 pub mod halfplane;
 pub mod history;
 pub mod io;

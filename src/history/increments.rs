@@ -123,6 +123,94 @@ pub fn step_dissipation(model: &ContactModel, old: &ContactState, new: &ContactS
     step_dissipation_with(model, old, new, rule)
 }
 
+/// q and the surface strain `∂ux/∂x` of `state` at each of `xs`, its pressure computed once
+/// for both.
+fn traction_and_strain(
+    model: &ContactModel,
+    state: &ContactState,
+    xs: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    let (mut p, mut h, mut q, mut strain) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    state.pressures_and_cauchys_into(xs, &mut p, &mut h);
+    state.tractions_with(xs, &p, &mut q);
+    state.strains_with(model, xs, (&p, &h), &mut strain);
+    (q, strain)
+}
+
+/// The slip increments `Δs(x) = Δux(x) − Δδ` of the step from `old` to `new` at the points
+/// `xs` (m; the half-plane's displacement relative to the punch, as the general solver's
+/// element slip): zero on the new stick zone and outside the new contact, and in a slip zone
+/// `Δs(x) = ∫ Δε` from the stick end to x ([`step_dissipation`]'s slip increment, with the
+/// same strain change and breakpoints). Each slip zone is cut at the points of `xs` inside
+/// it as well, so that one pass of the graded rule gives the running integral at every one:
+/// `slip_zone_rule_nodes(M)` nodes on the pieces that end at a breakpoint of the step or at
+/// a zone end, `grid_nodes` on those between two of `xs` (smooth inside).
+pub fn slip_increments(
+    model: &ContactModel,
+    old: &ContactState,
+    new: &ContactState,
+    xs: &[f64],
+    grid_nodes: usize,
+) -> Vec<f64> {
+    let mut out = vec![0.0; xs.len()];
+    let Some(stick) = new.traction.stick.as_ref() else {
+        return out;
+    };
+    let (left_end, right_end) = (new.centre - new.half_width, new.centre + new.half_width);
+    let breaks = crate::contact::step_breakpoints(old, new);
+    let full = crate::contact::slip_zone_rule_nodes(new.pressure.beta.len());
+    for (from, to) in [(stick.hi, right_end), (left_end, stick.lo)] {
+        let inside: Vec<usize> = (0..xs.len())
+            .filter(|&i| xs[i] > from && xs[i] < to)
+            .collect();
+        if inside.is_empty() {
+            continue;
+        }
+        let mut pts: Vec<f64> = breaks
+            .iter()
+            .copied()
+            .filter(|x| *x > from && *x < to)
+            .collect();
+        pts.extend([from, to]);
+        let singular = pts.clone();
+        pts.extend(inside.iter().map(|&i| xs[i]));
+        let is_singular = |x: f64| singular.iter().any(|s| s.to_bits() == x.to_bits());
+        let (at, weights) = crate::contact::graded_nodes(pts, |x0, x1| {
+            if is_singular(x0) || is_singular(x1) {
+                full
+            } else {
+                grid_nodes
+            }
+        });
+        let ((_, strain_new), (_, strain_old)) = (
+            traction_and_strain(model, new, &at),
+            traction_and_strain(model, old, &at),
+        );
+        let terms: Vec<f64> = weights
+            .iter()
+            .zip(strain_new.iter().zip(&strain_old))
+            .map(|(w, (n, o))| w * (n - o))
+            .collect();
+        // Right zone: Δs(x) = ∫_{hi}^{x} Δε; left zone: Δs(x) = −∫_{x}^{lo} Δε. Every point
+        // of `xs` ends pieces, so the nodes below it are those of the pieces before it.
+        let running: Vec<f64> = terms
+            .iter()
+            .scan(0.0, |sum, t| {
+                *sum += t;
+                Some(*sum)
+            })
+            .collect();
+        let total = running.last().copied().unwrap_or(0.0);
+        let right = from.to_bits() == stick.hi.to_bits();
+        for &i in &inside {
+            let below = at.partition_point(|&t| t < xs[i]);
+            let before = below.checked_sub(1).map_or(0.0, |k| running[k]);
+            out[i] = if right { before } else { before - total };
+        }
+    }
+    out
+}
+
 /// [`step_dissipation`] by the graded rule with `nodes` per piece, and `smooth` nodes of the
 /// plain rule on the pieces both of whose ends the balancing made (none: the graded rule on
 /// every piece; [`crate::contact::graded_cumulative`]).
@@ -138,14 +226,7 @@ fn step_dissipation_with(
     // q̄ onto `out` and Δε onto `changes` at each of xs, each state's pressure computed once
     // for its traction and strain.
     let mean_and_change = |xs: &[f64], out: &mut Vec<f64>, changes: &mut Vec<f64>| {
-        let fields = |state: &ContactState| {
-            let (mut p, mut h, mut q, mut strain) =
-                (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-            state.pressures_and_cauchys_into(xs, &mut p, &mut h);
-            state.tractions_with(xs, &p, &mut q);
-            state.strains_with(model, xs, (&p, &h), &mut strain);
-            (q, strain)
-        };
+        let fields = |state: &ContactState| traction_and_strain(model, state, xs);
         let ((q_new, strain_new), (q_old, strain_old)) = (fields(new), fields(old));
         out.extend(q_new.iter().zip(&q_old).map(|(n, o)| 0.5 * (o + n)));
         changes.extend(strain_new.iter().zip(&strain_old).map(|(n, o)| n - o));
@@ -205,6 +286,66 @@ mod tests {
     use crate::history::{LoadPoint, NoObserver, advance, driver_after_normal_loading};
 
     use super::*;
+
+    /// The slip increments at many points, with the mean traction, integrate to the step's
+    /// dissipation `−∫ q̄ Δs dx` ([`step_dissipation`], which integrates by parts and never
+    /// forms Δs): the midpoint rule on 2,000 and 4,000 points over the contact, over the first loading
+    /// and the first reversal of the default (coupled PZT-4) history at M = 64, to the
+    /// dissipation in the part of the contact that the step leaves.
+    #[test]
+    fn the_slip_increments_integrate_to_the_step_dissipation() {
+        let sc = crate::scenario::default_scenario();
+        let disc = Discretisation::new(64);
+        let mut driver = driver_after_normal_loading(&sc, &disc);
+        let steps = sc.history.as_ref().expect("default history").steps();
+        let (mut worst, mut largest) = ([0.0f64; 2], 0.0f64);
+        for (i, &(_, t, q)) in steps.iter().take(20).enumerate() {
+            let old = driver.state.clone();
+            let point = LoadPoint {
+                step: i + 1,
+                t,
+                q,
+                punch: None,
+            };
+            advance(
+                &sc.model,
+                &disc,
+                &mut driver,
+                point,
+                SlipOptions::default(),
+                &mut NoObserver,
+            )
+            .unwrap();
+            let new = &driver.state;
+            let (lo, hi) = (new.centre - new.half_width, new.centre + new.half_width);
+            let exact = step_dissipation(&sc.model, &old, new);
+            largest = largest.max(exact.abs());
+            for (k, n) in [2000, 4000].into_iter().enumerate() {
+                let h = (hi - lo) / n as f64;
+                let xs: Vec<f64> = (0..n).map(|j| lo + (j as f64 + 0.5) * h).collect();
+                let slips = slip_increments(&sc.model, &old, new, &xs, 16);
+                let (mut q_new, mut q_old) = (Vec::new(), Vec::new());
+                new.tractions_into(&xs, &mut q_new);
+                old.tractions_into(&xs, &mut q_old);
+                let by_points: f64 = (0..n)
+                    .map(|j| -0.5 * (q_new[j] + q_old[j]) * slips[j] * h)
+                    .sum();
+                worst[k] = worst[k].max((by_points - exact).abs());
+            }
+        }
+        let relative = [worst[0] / largest, worst[1] / largest];
+        println!(
+            "−∫ q̄ Δs by 2,000 and 4,000 points within {:.2e} and {:.2e} of the largest step \
+             dissipation",
+            relative[0], relative[1]
+        );
+        assert!(largest > 0.0);
+        // Measured 4.5e−5 and 4.4e−5: not the points' error, which is smaller, but the
+        // sliver of contact that the step's state leaves (the contact moves by about 2e−3 a a
+        // step here), whose slip the dissipation counts over both states' contacts and the
+        // slip increments, by their definition, do not (about 1e−12 J/m a step).
+        assert!(relative[0] < 1e-4 && relative[1] < 1e-4, "{relative:?}");
+    }
 
     /// The dissipation's rule (the graded rule, and the plain rule on the pieces that the
     /// balancing made at both ends, `slip_zone_smooth_nodes`) gives the step dissipations as

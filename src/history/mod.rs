@@ -114,7 +114,7 @@ internal_use! { driver::{DriverState, SolvedStep, Trial, Tried, finish_step, try
 #[cfg(any(test, feature = "internals"))]
 pub use driver::{Solved, advance, solve_step};
 internal_use! { general::{GeneralRun, GeneralRunData}; }
-internal_use! { increments::{IncrementInputs, StepIncrements, step_dissipation}; }
+internal_use! { increments::{IncrementInputs, StepIncrements, slip_increments, step_dissipation}; }
 internal_use! { normal::{load_by_steps, locked_in_strain_slope}; }
 internal_use! { record::SolvedStateData; }
 internal_use! { regime::{PhaseEvent, next_regime, phase_event}; }

@@ -46,6 +46,9 @@ pub(crate) struct Kept<S = SolvedState> {
     pub(crate) at_times: Vec<Option<(StepRecord, S)>>,
     /// The steps handed to the general solver.
     pub(crate) handovers: HandoverLog,
+    /// The fretting-fatigue indicators under way (a run with a history).
+    #[serde(default)]
+    pub(crate) fatigue: Option<crate::fatigue::FatigueAnalysis>,
 }
 
 impl Kept<SolvedStateData> {
@@ -59,6 +62,7 @@ impl Kept<SolvedStateData> {
             last: self.last.into_iter().map(one).collect(),
             at_times: self.at_times.into_iter().map(|s| s.map(one)).collect(),
             handovers: self.handovers,
+            fatigue: self.fatigue,
         }
     }
 }

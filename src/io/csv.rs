@@ -193,6 +193,10 @@ pub fn cycles_table(cycles: &[CycleRow]) -> Table {
                 "energy_ratio",
                 Column::MaybeReal(c.iter().map(|c| c.energy_ratio).collect()),
             ),
+            (
+                "max_local_slip_m",
+                Column::MaybeReal(c.iter().map(|c| c.max_local_slip).collect()),
+            ),
         ],
     }
 }

@@ -27,6 +27,7 @@
 
 internal! { mod checkpoint; }
 internal! { mod csv; }
+internal! { mod fatigue; }
 internal! { mod folder; }
 internal! { mod history_plots; }
 internal! { mod plots; }

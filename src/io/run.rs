@@ -13,7 +13,9 @@ use crate::error::Error;
 use crate::history::HistoryStateView;
 use crate::history::{RunOptions, SolvedState, StateView, StepRecord};
 use crate::io::checkpoint::{Kept, Resume, RunSink, write_records, write_state};
+use crate::fatigue::{FatigueAnalysis, FatigueProfile, step_samples};
 use crate::io::csv::{StepsCsv, cycles_table, fields_table};
+use crate::io::fatigue::{FatigueSummary, fatigue_plot, fatigue_table};
 use crate::io::folder::{Protected, RunFolder};
 use crate::io::history_plots::{PlotWindow, history_plots};
 use crate::io::plots::{
@@ -54,6 +56,8 @@ pub struct Solution {
     pub records: Vec<crate::history::StepRecord>,
     /// The cycles of the history.
     pub cycles: Vec<CycleRow>,
+    /// The fretting-fatigue indicators of the last complete cycle ([`crate::fatigue`]).
+    pub fatigue: Option<FatigueProfile>,
     /// The solver failure that stopped the history part-way, if any.
     pub failure: Option<Error>,
     /// The state at the last accepted step of a history that stopped part-way (written into
@@ -132,6 +136,11 @@ pub(crate) struct Snapshots<'a> {
 impl crate::history::Observer for Snapshots<'_> {
     fn on_step(&mut self, record: &crate::history::StepRecord, state: StateView<'_>) {
         let kept = &mut self.kept;
+        if let Some(fatigue) = &mut kept.fatigue {
+            let before = kept.previous.as_ref().map(|(_, s)| s.view());
+            let samples = step_samples(&self.scenario.model, fatigue.grid(), before, state);
+            fatigue.push(record, samples);
+        }
         if let Some((prev, prev_state)) = kept.previous.take()
             && prev.phase != record.phase
             && prev.phase > 0
@@ -412,6 +421,11 @@ pub(crate) fn solve_from<'a>(
                 last: Vec::new(),
                 at_times: vec![None; scenario.snapshots.len()],
                 handovers: HandoverLog::default(),
+                fatigue: scenario.history.as_ref().map(|_| {
+                    let (centre, half_width) = normal.solved_state().contact();
+                    let grid = field_points(centre, half_width, scenario.raw.output.field_points);
+                    FatigueAnalysis::new(grid, half_width)
+                }),
             },
             None,
         ),
@@ -470,7 +484,7 @@ pub(crate) fn solve_from<'a>(
         return Err(e);
     }
     let stopped_when_settled = snapshots.stopped.get();
-    let kept = snapshots.kept;
+    let mut kept = snapshots.kept;
     let records_held = snapshots.held;
     let mut digest = snapshots.digest;
     digest.finish_steps()?;
@@ -482,7 +496,11 @@ pub(crate) fn solve_from<'a>(
     } = digest;
     warnings.extend(stalled_warning(&tally));
     let tolerance = scenario.raw.numerics.cycle_tolerance;
-    let (cycles, verdict) = cycles.finish(tolerance);
+    let (mut cycles, verdict) = cycles.finish(tolerance);
+    let fatigue = kept
+        .fatigue
+        .take()
+        .and_then(|analysis| with_local_slip(analysis, &mut cycles));
     let history_summary = scenario
         .history
         .as_ref()
@@ -572,6 +590,9 @@ pub(crate) fn solve_from<'a>(
         history: history_summary,
         snapshots: snapshot_rows,
         solver: solver_statistics(scenario, &normal, &tally, kept.handovers),
+        fatigue: fatigue
+            .as_ref()
+            .map(|f| FatigueSummary::of(f, model.compliance.electric.is_some())),
         warnings,
     };
     Ok(Solution {
@@ -580,12 +601,28 @@ pub(crate) fn solve_from<'a>(
         turning_fields,
         records,
         cycles,
+        fatigue,
         failure,
         failure_state,
         last: tally.last().cloned(),
         plots: scenario.history.as_ref().map(|_| plots),
         records_held,
     })
+}
+
+/// The cycles' largest local slip amplitudes from `analysis` put into their rows (a cycle
+/// of the analysis is a row's when their first and last steps agree), and the indicators of
+/// the last row's cycle.
+fn with_local_slip(analysis: FatigueAnalysis, rows: &mut [CycleRow]) -> Option<FatigueProfile> {
+    let (slips, last) = analysis.finish();
+    for row in rows.iter_mut() {
+        row.max_local_slip = slips
+            .iter()
+            .find(|s| s.steps == row.steps)
+            .map(|s| s.max_local_slip);
+    }
+    let row = rows.last()?;
+    last.into_iter().rev().find(|p| p.steps == row.steps)
 }
 
 /// The rest of `history` after step `step`, from `state` after the steps `records` (all those
@@ -709,6 +746,7 @@ pub(crate) fn write_solution(
         fields,
         turning_fields,
         cycles,
+        fatigue,
         failure,
         failure_state,
         last,
@@ -725,6 +763,10 @@ pub(crate) fn write_solution(
     // `steps.csv` is written as the steps are taken (`Digest`).
     if scenario.history.is_some() {
         folder.write("cycles.csv", &cycles_table(cycles).csv())?;
+    }
+    let electric = scenario.model.compliance.electric.is_some();
+    if let Some(profile) = fatigue {
+        folder.write("fatigue.csv", &fatigue_table(profile, electric).csv())?;
     }
     {
         let mut put = |name: String, bytes: &[u8]| folder.write(&name, bytes);
@@ -774,6 +816,10 @@ pub(crate) fn write_solution(
             .iter()
             .map(|f| (f.label.as_str(), f.points.as_slice(), f.ends))
             .collect();
+        section(
+            "Fretting-fatigue indicators (last complete cycle)",
+            fatigue.iter().map(|p| fatigue_plot(p, &scales)).collect(),
+        )?;
         section(
             "Fields at the snapshot instants",
             family_plots("snapshots", "at the snapshot instants", &instants, &scales),
@@ -886,8 +932,14 @@ mod tests {
             assert!(read("steps.csv") == crate::io::csv::steps_table(&memory.records, friction).csv());
             let tolerance = scenario.raw.numerics.cycle_tolerance;
             let control = scenario.history.as_ref().unwrap().control;
-            let (cycles, verdict) =
+            let (mut cycles, verdict) =
                 crate::analysis::analyse_cycles(&memory.records, control, tolerance);
+            // The largest local slip amplitudes need the states: those of the run in memory.
+            assert_eq!(cycles.len(), memory.cycles.len());
+            for (row, kept) in cycles.iter_mut().zip(&memory.cycles) {
+                row.max_local_slip = kept.max_local_slip;
+            }
+            assert!(memory.cycles.iter().all(|c| c.max_local_slip.is_some()));
             assert!(read("cycles.csv") == cycles_table(&cycles).csv());
             let summary = serde_json::to_vec_pretty(&memory.summary).unwrap();
             assert!(read("summary.json") == summary);

@@ -95,6 +95,10 @@ pub struct Summary {
     pub snapshots: Vec<SnapshotSummary>,
     /// Work counters and checks.
     pub solver: SolverStatistics,
+    /// The fretting-fatigue indicators of the last complete cycle (absent without a history
+    /// or without a complete cycle).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fatigue: Option<crate::io::fatigue::FatigueSummary>,
     /// Warnings.
     pub warnings: Vec<String>,
 }

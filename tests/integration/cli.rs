@@ -98,6 +98,42 @@ struct Cycle {
     regime: String,
     slip_amplitude: Option<f64>,
     energy_ratio: Option<f64>,
+    max_local_slip: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)] // pins the schema: every field must be there, not every one is asserted on
+struct Extreme {
+    value: f64,
+    x: f64,
+    x_over_a: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)] // pins the schema: every field must be there, not every one is asserted on
+struct FatigueMaxima {
+    slip_amplitude: Extreme,
+    sigma_xx_max: Extreme,
+    sigma_xx_range: Extreme,
+    ruiz_f1: Extreme,
+    ruiz_f2: Extreme,
+    swt: Extreme,
+    d_x_range: Option<Extreme>,
+    e_x_range: Option<Extreme>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)] // pins the schema: every field must be there, not every one is asserted on
+struct Fatigue {
+    cycle: usize,
+    first_step: usize,
+    last_step: usize,
+    grid_points: usize,
+    half_width: f64,
+    maxima: FatigueMaxima,
 }
 
 #[derive(Debug, Deserialize, PartialEq)]
@@ -175,6 +211,9 @@ struct Summary {
     history: Option<History>,
     snapshots: Vec<Snapshot>,
     solver: Solver,
+    /// Present with a complete cycle only.
+    #[serde(default)]
+    fatigue: Option<Fatigue>,
     warnings: Vec<String>,
 }
 
@@ -192,7 +231,11 @@ delta_m,dissipation_J_per_m,solver,stick_zones,slip_zones,slip_sign_changes";
 const CYCLES_HEADER: &str = "cycle,first_step,last_step,Q_start_N_per_m,Q_min_N_per_m,\
 Q_end_N_per_m,loop_area_J_per_m,friction_work_J_per_m,normal_work_J_per_m,electric_work_J_per_m,\
 delta_at_max_m,delta_at_min_m,stick_lo_at_max_m,stick_hi_at_max_m,stick_lo_at_min_m,\
-stick_hi_at_min_m,change_vs_previous,compared_with_cycle,regime,slip_amplitude_m,energy_ratio";
+stick_hi_at_min_m,change_vs_previous,compared_with_cycle,regime,slip_amplitude_m,energy_ratio,\
+max_local_slip_m";
+const FATIGUE_HEADER: &str = "x_m,x_over_a,slip_amplitude_m,sigma_xx_max_Pa,sigma_xx_min_Pa,\
+sigma_xx_range_Pa,shear_traction_max_Pa,ruiz_f1_J_per_m2,ruiz_f2_Pa_J_per_m2,strain_amplitude,swt_Pa";
+const FATIGUE_ELECTRIC: &str = ",d_x_range_C_per_m2,e_x_range_V_per_m";
 
 /// A CSV file's header and its data rows as numbers (non-numeric cells, such as the regime,
 /// become NaN).
@@ -373,6 +416,30 @@ fn run_checked(scenario: &Path) -> (tempfile::TempDir, PathBuf, Summary) {
             for p in ["hysteresis", "hysteresis_slip", "stick_zone"] {
                 assert!(index.contains(&format!("plots/{p}.svg")));
             }
+            // The fatigue indicators of the last complete cycle, with each cycle's largest
+            // local slip amplitude.
+            let piezo = raw["material"]["kind"] != "elastic";
+            match &s.fatigue {
+                Some(f) => {
+                    let (header, rows) = read_csv(&out.join("fatigue.csv"));
+                    let electric = if piezo { FATIGUE_ELECTRIC } else { "" };
+                    assert_eq!(header, format!("{FATIGUE_HEADER}{electric}"));
+                    assert_eq!((rows.len(), f.grid_points), (field_points, field_points));
+                    let last = h.cycles.last().expect("a cycle");
+                    assert_eq!(
+                        (f.cycle, f.first_step, f.last_step),
+                        (h.cycle_count, last.steps.0, last.steps.1)
+                    );
+                    assert_eq!(last.max_local_slip, Some(f.maxima.slip_amplitude.value));
+                    assert_eq!(f.maxima.d_x_range.is_some(), piezo);
+                    assert_svg(&out.join("plots/fatigue.svg"), 4);
+                    assert!(index.contains("plots/fatigue.svg") && index.contains("fatigue.csv"));
+                }
+                None => {
+                    assert_eq!(h.cycle_count, 0, "{}", scenario.display());
+                    assert!(!out.join("fatigue.csv").exists());
+                }
+            }
             // Turning-point fields, unless switched off.
             let turning = raw["output"]["turning_point_fields"] != serde_json::json!(false)
                 && raw["output"]["turning_point_fields"] != serde_json::json!("none");
@@ -452,7 +519,7 @@ fn run_scenario(name: &str) -> (tempfile::TempDir, PathBuf, Summary) {
 }
 
 /// The scenarios with a test of their own below; a file in `scenarios/` without one fails.
-const SCENARIOS: [&str; 18] = [
+const SCENARIOS: [&str; 19] = [
     "baseline",
     "charge_history",
     "cattaneo_mindlin_uncoupled",
@@ -463,6 +530,7 @@ const SCENARIOS: [&str; 18] = [
     "figure4_fretting",
     "figure5_frictionless",
     "flat_punch_fretting",
+    "fretting_fatigue",
     "insulating",
     "many_cycles",
     "normal_load_in_phase",
@@ -1080,6 +1148,29 @@ fn scenario_figure4_fretting() {
 
 /// Ten ±½ηP cycles of the uncoupled contact: Masing behaviour, so every cycle repeats the
 /// first (the verdict is steady from cycle 1) and the last cycle's extremes are the first's.
+/// The steady Mindlin–Deresiewicz cycle of the uncoupled cylinder: its fatigue indicators
+/// (checked against the closed forms in `fatigue.rs`) peak at the contact ends, and every
+/// cycle has the same largest local slip amplitude.
+#[test]
+fn scenario_fretting_fatigue() {
+    let (_tmp, out, s) = run_scenario("fretting_fatigue");
+    let h = s.history.as_ref().unwrap();
+    assert_eq!(h.verdict, Verdict::SteadyCyclicSlip { from_cycle: 1 });
+    let f = s.fatigue.as_ref().expect("a fatigue section");
+    assert_eq!(f.cycle, 2);
+    let m = &f.maxima;
+    assert!(
+        m.slip_amplitude.x_over_a.abs() > 0.99,
+        "{:?}",
+        m.slip_amplitude
+    );
+    // σxx0 peaks in tension just outside the trailing contact end (McEwen).
+    assert!(m.sigma_xx_max.x_over_a.abs() > 0.99 && m.sigma_xx_max.value > 0.0);
+    let slips: Vec<f64> = h.cycles.iter().map(|c| c.max_local_slip.unwrap()).collect();
+    assert!((slips[0] - slips[1]).abs() < 1e-9 * slips[0], "{slips:?}");
+    assert!(out.join("plots/fatigue.png").exists());
+}
+
 #[test]
 fn scenario_many_cycles() {
     let (_tmp, out, s) = run_scenario("many_cycles");

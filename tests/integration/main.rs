@@ -2,6 +2,7 @@
 
 mod accelerations;
 mod cli;
+mod fatigue;
 mod fuzz;
 mod hybrid;
 mod load_paths;
