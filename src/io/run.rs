@@ -421,7 +421,7 @@ pub(crate) fn solve_from<'a>(
                 last: Vec::new(),
                 at_times: vec![None; scenario.snapshots.len()],
                 handovers: HandoverLog::default(),
-                fatigue: scenario.history.as_ref().map(|_| {
+                fatigue: scenario.history.as_ref().filter(|_| scenario.raw.output.fatigue).map(|_| {
                     let (centre, half_width) = normal.solved_state().contact();
                     let grid = field_points(centre, half_width, scenario.raw.output.field_points);
                     FatigueAnalysis::new(grid, half_width)

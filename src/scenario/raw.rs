@@ -62,6 +62,11 @@ pub struct RawOutput {
     /// nominal size; default false: rendering costs about 0.1 s and tens of MB per plot).
     #[serde(default)]
     pub png: bool,
+    /// Follow the fretting-fatigue indicators over each cycle of a history
+    /// ([`crate::fatigue`]; `fatigue.csv`, the summary's `fatigue` section, `max_local_slip_m`
+    /// in `cycles.csv`, `plots/fatigue`); default true.
+    #[serde(default = "default_true")]
+    pub fatigue: bool,
     /// Fields below the surface (stresses, von Mises, and the electric fields of a
     /// piezoelectric solid) on a grid of points (x, z), written to `subsurface/<stem>.csv`
     /// and mapped at every instant that gets a field file; absent (the default): none.
@@ -173,9 +178,14 @@ impl Default for RawOutput {
             field_points: default_field_points(),
             plot_units: PlotUnits::default(),
             png: false,
+            fatigue: true,
             subsurface: None,
         }
     }
+}
+
+pub(super) fn default_true() -> bool {
+    true
 }
 
 pub(super) fn default_field_points() -> usize {

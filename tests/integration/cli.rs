@@ -436,7 +436,8 @@ fn run_checked(scenario: &Path) -> (tempfile::TempDir, PathBuf, Summary) {
                     assert!(index.contains("plots/fatigue.svg") && index.contains("fatigue.csv"));
                 }
                 None => {
-                    assert_eq!(h.cycle_count, 0, "{}", scenario.display());
+                    let off = raw["output"]["fatigue"] == serde_json::json!(false);
+                    assert!(off || h.cycle_count == 0, "{}", scenario.display());
                     assert!(!out.join("fatigue.csv").exists());
                 }
             }
@@ -1169,6 +1170,30 @@ fn scenario_fretting_fatigue() {
     let slips: Vec<f64> = h.cycles.iter().map(|c| c.max_local_slip.unwrap()).collect();
     assert!((slips[0] - slips[1]).abs() < 1e-9 * slips[0], "{slips:?}");
     assert!(out.join("plots/fatigue.png").exists());
+}
+
+/// `output.fatigue = false` skips the indicators and only them: no `fatigue.csv`, no
+/// `fatigue` section or plot, an empty `max_local_slip_m`; `steps.csv` and the fields are the
+/// same bytes as with them.
+#[test]
+fn the_fatigue_indicators_can_be_switched_off() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut raw: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scenario_path("fretting_fatigue")).unwrap())
+            .unwrap();
+    raw["output"]["fatigue"] = serde_json::json!(false);
+    let file = tmp.path().join("off.json");
+    std::fs::write(&file, raw.to_string()).unwrap();
+    let (_tmp_off, off, s) = run_checked(&file);
+    let (_tmp_on, on, _) = run_scenario("fretting_fatigue");
+    assert!(s.fatigue.is_none());
+    assert!(!off.join("fatigue.csv").exists() && !off.join("plots/fatigue.svg").exists());
+    assert!(on.join("fatigue.csv").exists());
+    let h = s.history.as_ref().unwrap();
+    assert!(h.cycles.iter().all(|c| c.max_local_slip.is_none()));
+    let read = |dir: &Path, name: &str| std::fs::read(dir.join(name)).unwrap();
+    assert!(read(&off, "steps.csv") == read(&on, "steps.csv"));
+    assert!(read(&off, "fields/normal_loading.csv") == read(&on, "fields/normal_loading.csv"));
 }
 
 #[test]
