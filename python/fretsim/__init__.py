@@ -105,7 +105,10 @@ class Result:
     each one's legend. ``subsurface`` holds, under ``output.subsurface``, the fields below the
     surface at the same instants, by the same stems: the columns of ``subsurface/<stem>.csv``
     (``x_m``, ``z_m``, ``sxx_Pa``, ``von_mises_Pa``...), one value per grid point, x
-    varying fastest (``reshape(nz, nx)`` gives a map). ``failure`` is the error that stopped
+    varying fastest (``reshape(nz, nx)`` gives a map). ``fatigue`` holds the columns of
+    ``fatigue.csv`` (the fretting-fatigue indicators of the last complete cycle on the field
+    grid: ``slip_amplitude_m``, ``ruiz_f2_Pa_J_per_m2``, ``swt_Pa``...), or None without a
+    complete cycle (or with ``output.fatigue`` false). ``failure`` is the error that stopped
     the history part-way, or None.
     """
 
@@ -115,6 +118,7 @@ class Result:
     fields: Dict[str, Dict[str, np.ndarray]]
     labels: Dict[str, str] = field(default_factory=dict)
     subsurface: Dict[str, Dict[str, np.ndarray]] = field(default_factory=dict)
+    fatigue: Optional[Dict[str, np.ndarray]] = None
     failure: Optional[str] = None
 
     @property
@@ -134,6 +138,7 @@ class Result:
             fields=fields,
             labels=labels,
             subsurface={stem: _table(cols) for stem, cols in raw["subsurface"].items()},
+            fatigue=None if raw["fatigue"] is None else _table(raw["fatigue"]),
             failure=raw["failure"],
         )
 

@@ -5,7 +5,9 @@
 use std::path::Path;
 
 use fretsim::error::Error;
-use fretsim::io::{Column, Table, cycles_table, fields_table, steps_table, subsurface_table};
+use fretsim::io::{
+    Column, Table, cycles_table, fatigue_table, fields_table, steps_table, subsurface_table,
+};
 use fretsim::scenario::{self, Scenario};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
@@ -100,13 +102,15 @@ fn table_dict<'py>(py: Python<'py>, table: &Table) -> PyResult<Bound<'py, PyDict
 
 /// What a solved scenario gives Python: the summary (JSON), the step, cycle and field tables,
 /// the tables of the fields below the surface (`output.subsurface`) by the stem of their
-/// field file, and the failure that stopped the history, if any.
+/// field file, the fretting-fatigue indicators of the last complete cycle (`fatigue.csv`),
+/// and the failure that stopped the history, if any.
 struct Outcome {
     summary: String,
     steps: Table,
     cycles: Table,
     fields: Vec<(String, String, Table)>,
     subsurface: Vec<(String, Table)>,
+    fatigue: Option<Table>,
     failure: Option<String>,
 }
 
@@ -122,6 +126,10 @@ fn outcome(scenario: &Scenario, solution: &fretsim::io::Solution) -> Outcome {
         subsurface: all()
             .filter_map(|f| Some((f.stem.clone(), subsurface_table(f.subsurface.as_ref()?))))
             .collect(),
+        fatigue: solution
+            .fatigue
+            .as_ref()
+            .map(|f| fatigue_table(f, scenario.model.compliance.electric.is_some())),
         failure: solution.failure.as_ref().map(|e| e.to_string()),
     }
 }
@@ -143,6 +151,10 @@ fn outcome_dict<'py>(py: Python<'py>, o: &Outcome) -> PyResult<Bound<'py, PyDict
         subsurface.set_item(stem, table_dict(py, table)?)?;
     }
     dict.set_item("subsurface", subsurface)?;
+    match &o.fatigue {
+        Some(table) => dict.set_item("fatigue", table_dict(py, table)?)?,
+        None => dict.set_item("fatigue", py.None())?,
+    }
     dict.set_item("failure", &o.failure)?;
     Ok(dict)
 }

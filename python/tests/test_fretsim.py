@@ -75,6 +75,26 @@ def test_subsurface_maps_equal_the_command_lines_files(tmp_path):
     np.testing.assert_allclose(table["szz_Pa"].reshape(41, 80)[0], -hertz, atol=1e-6 * p0)
 
 
+def test_fatigue_indicators_equal_the_command_lines_file(tmp_path):
+    """`Result.fatigue` is the command line's `fatigue.csv` to its 10 digits; the largest slip
+    amplitude is the last cycle's `max_local_slip_m`; without a complete cycle it is None."""
+    scenario = SCENARIOS / "fretting_fatigue.json"
+    out = tmp_path / "cli"
+    subprocess.run([BINARY, "run", scenario, "--out", out, "--quiet"], check=True)
+    result = fretsim.run(scenario)
+    header, rows = read_csv(out / "fatigue.csv")
+    assert list(result.fatigue) == header
+    for k, name in enumerate(header):
+        np.testing.assert_allclose(
+            result.fatigue[name], np.array([r[k] for r in rows], float), rtol=1e-9
+        )
+    largest = result.fatigue["slip_amplitude_m"].max()
+    assert largest == pytest.approx(result.cycles["max_local_slip_m"][-1], rel=1e-9)
+    half = fretsim.load(scenario)
+    half["tangential_history"] = {"unit": "fraction_of_limit", "points": [[0, 0], [1, 0.5]]}
+    assert fretsim.run(half).fatigue is None
+
+
 def test_cattaneo_mindlin_stick_zone_at_the_first_peak():
     """Uncoupled elastic contact (ν = 0.5): at the first peak Q = 0.6 ηP the stick zone is
     |x − c| ≤ a √(1 − Q/(ηP)) (Cattaneo–Mindlin)."""

@@ -40,6 +40,7 @@ internal! { mod sweep; }
 mod sweep_plots;
 
 pub use self::csv::{Column, Table, cycles_table, fields_table, steps_table};
+pub use fatigue::fatigue_table;
 pub(crate) use run::run_resumed;
 pub use run::{FieldSet, RunResult, Solution, run, run_partial, solve};
 pub use subsurface::{SubsurfaceGrid, SubsurfaceMap, subsurface_table};
