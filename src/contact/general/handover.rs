@@ -130,7 +130,7 @@ impl Solver {
         let n = mesh.len();
         let c = &self.coefficients;
         let (y23, y33, w13) = c.electric.unwrap_or((0.0, 0.0, 0.0));
-        let fixed = self.fixed_displacement(&pressure, &charge);
+        let fixed = self.fixed_displacement(&pressure, &charge, loads.bulk_stress);
         let (mut lp, mut lq, mut lg, mut sq) =
             (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         self.influence.log_apply(&pressure, &mut lp);
@@ -255,6 +255,7 @@ mod tests {
             normal: 2000.0,
             tangential: q,
             electric: 6e-7,
+            bulk_stress: 0.0,
         }
     }
 
