@@ -241,7 +241,14 @@ impl Digest {
             h.points.iter().map(|p| p.1.abs()).fold(0.0, f64::max)
         });
         let steps = match steps {
-            Some((path, out)) => match StepsCsv::new(out, scenario.model.friction) {
+            Some((path, out)) => match StepsCsv::new(
+                out,
+                scenario.model.friction,
+                scenario
+                    .history
+                    .as_ref()
+                    .is_some_and(|h| h.has_bulk_stress()),
+            ) {
                 Ok(csv) => Some((path, csv)),
                 Err(source) => return Err(Error::WriteOutput { path, source }),
             },

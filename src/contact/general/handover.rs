@@ -182,7 +182,8 @@ impl Solver {
     }
 
     /// p, q, g, σxx0 and Dx0 of an element state at x (module docs); zero fields outside the
-    /// mesh's elements in contact.
+    /// mesh's elements in contact. σxx0 includes the bulk stress σB of the state's loads (the
+    /// uniform state adds `σxx = σB` and nothing to Dx).
     pub fn surface_point(
         &self,
         model: &ContactModel,
@@ -213,7 +214,9 @@ impl Solver {
         );
         let strain = -c.w12 * p - w13 * g + c.y11 * cauchy(&state.shear);
         let gradient = w13 * q + y23 * cauchy(&state.pressure) + y33 * cauchy(&state.charge);
-        model.surface_fields(x, (p, q, g), strain, gradient)
+        let mut point = model.surface_fields(x, (p, q, g), strain, gradient);
+        point.sigma_xx += state.loads.bulk_stress;
+        point
     }
 }
 
