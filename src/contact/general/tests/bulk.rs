@@ -133,3 +133,28 @@ fn zero_bulk_stress_changes_nothing() {
     assert_eq!(back, stressed);
     assert_ne!(stressed.shear, plain.shear);
 }
+
+/// The surface stress σxx0 (seed eqs. 64–65) includes σB: the same tractions with and without
+/// the bulk stress differ in σxx0 by σB exactly, inside and outside the contact, and not in Dx0.
+#[test]
+fn surface_sigma_xx_includes_the_bulk_stress() {
+    let model = elastic(0.5, 0.3, Coupling::Full);
+    let p = 2240.0;
+    let a = Hertz::new(p, radius_of(&model), model.compliance.y22).half_width;
+    let solver = Solver::new(&model, graded_stick(a, 4e-3), Options::default());
+    let (s0, _) = solver
+        .step(&GeneralState::unloaded(solver.mesh().clone()), loads(p, 0.0))
+        .unwrap();
+    let sigma = 3e6;
+    let (stressed, _) = solver.step(&s0, with_bulk(p, 0.1 * p, sigma)).unwrap();
+    let mut bare = stressed.clone();
+    bare.loads.bulk_stress = 0.0;
+    for x in [-1.05 * a, -0.5 * a, 0.013 * a, 0.7 * a, 1.08 * a] {
+        let (with, without) = (
+            solver.surface_point(&model, &stressed, x),
+            solver.surface_point(&model, &bare, x),
+        );
+        assert!((with.sigma_xx - without.sigma_xx - sigma).abs() < 1e-9 * sigma);
+        assert!((with.d_x - without.d_x).abs() <= 0.0);
+    }
+}
