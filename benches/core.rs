@@ -378,6 +378,7 @@ fn general_loaded(
             normal: normal_load * f * f,
             tangential: 0.0,
             electric: electric * f,
+            bulk_stress: 0.0,
         };
         state = solver.step(&state, loads).unwrap().0;
     }

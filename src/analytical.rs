@@ -197,6 +197,68 @@ impl CattaneoMindlin {
     }
 }
 
+/// Cattaneo–Mindlin with a bulk stress σB along the surface, for a **rigid** punch on the
+/// uncoupled half-plane (only the half-plane strains): after pressing to P, Q and σB raised
+/// from zero in proportion (or in one step), the stick zone is `|x − e| ≤ c` with
+///
+/// ```text
+/// c/a = √(1 − |Q|/(ηP)),   e = sign(Q) a s̃ σB/(y11 ηp0) = sign(Q) aσB/(2ηp0),
+/// q = sign(Q) η p0 [√(1 − x²/a²) − (c/a)√(1 − (x − e)²/c²)]   (inner term on |x − e| < c)
+/// ```
+///
+/// (`s̃ = (1 − ν²)/E` the bulk compliance, `y11 = 2(1 − ν²)/E`): the q-part of the surface
+/// strain on the stick zone is `−sign(Q) y11 ηp0 e/a`, which cancels the bulk strain `s̃σB`.
+/// Nowell and Hills' `e = aσB/(4ηp0)` is for two similar elastic bodies, whose tangential
+/// compliance is twice the rigid punch's. It needs `|e| + c ≤ a`, and along a proportional
+/// path (Q*, σB*) slip that never reverses: nested stick zones and growing slip, which
+/// `|σB*|/p0 ≤ |Q*|/P` ensures.
+#[derive(Debug, Clone, Copy)]
+pub struct BulkStressCattaneo {
+    /// The contact without bulk stress.
+    pub contact: CattaneoMindlin,
+}
+
+impl BulkStressCattaneo {
+    /// From the Cattaneo–Mindlin contact.
+    pub fn new(contact: CattaneoMindlin) -> Self {
+        Self { contact }
+    }
+
+    /// The stick zone's centre e (m) under Q (N/m) and σB (Pa).
+    pub fn offset(&self, q: f64, bulk_stress: f64) -> f64 {
+        let c = &self.contact;
+        q.signum() * c.half_width * bulk_stress / (2.0 * c.friction * c.peak_pressure)
+    }
+
+    /// The stick zone's half-width c (m) under Q.
+    pub fn stick_half_width(&self, q: f64) -> f64 {
+        self.contact.half_width * self.contact.stick_ratio(q)
+    }
+
+    /// Whether the stick zone lies in the contact, `|e| + c ≤ a`.
+    pub fn holds(&self, q: f64, bulk_stress: f64) -> bool {
+        self.offset(q, bulk_stress).abs() + self.stick_half_width(q) <= self.contact.half_width
+    }
+
+    /// The traction q(x) (Pa).
+    pub fn traction(&self, q: f64, bulk_stress: f64, x: f64) -> f64 {
+        let cm = &self.contact;
+        let a = cm.half_width;
+        let r = x / a;
+        if r.abs() >= 1.0 {
+            return 0.0;
+        }
+        let (e, c) = (self.offset(q, bulk_stress), self.stick_half_width(q));
+        let t = (x - e) / c;
+        let inner = if t.abs() < 1.0 {
+            (c / a) * (1.0 - t * t).sqrt()
+        } else {
+            0.0
+        };
+        q.signum() * cm.friction * cm.peak_pressure * ((1.0 - r * r).sqrt() - inner)
+    }
+}
+
 impl CattaneoMindlin {
     /// Punch displacement after loading from 0 to Q (m), for tangential compliance `y11 = 2/E*`
     /// and datum distance d (the regularised kernel `−ln(|r|/d)`):

@@ -393,6 +393,31 @@ impl Material {
     pub fn is_piezoelectric(&self) -> bool {
         matches!(self, Material::Piezoelectric(_))
     }
+
+    /// The plane-strain compliance of a uniform bulk stress along the surface, `εxx = s̃ σxx`
+    /// (1/Pa): the state `σxx = σB` with `σzz = σxz = 0`, `εyy = 0` and, for a piezoelectric
+    /// solid, open circuit `Dz = 0` (the surface outside the contact carries no charge) and
+    /// `Ex = Dx = 0`. From `σzz = 0` and `Dz = 0`,
+    ///
+    /// ```text
+    /// 1/s̃ = c11 − (c13² ε33 + 2 c13 e31 e33 − c33 e31²)/(c33 ε33 + e33²)
+    /// ```
+    ///
+    /// which for an isotropic solid is `E/(1 − ν²)` (then `s̃ = (1 − ν²)/E`). The state's
+    /// surface potential `φ = Ez·z` is zero at z = 0, so a conducting punch's condition is
+    /// unchanged.
+    pub fn bulk_compliance(&self) -> f64 {
+        match self {
+            Material::Piezoelectric(c) => {
+                let det = c.c33 * c.eps33 + c.e33 * c.e33;
+                let reduction = (c.c13 * c.c13 * c.eps33 + 2.0 * c.c13 * c.e31 * c.e33
+                    - c.c33 * c.e31 * c.e31)
+                    / det;
+                1.0 / (c.c11 - reduction)
+            }
+            Material::Elastic(c) => 1.0 / c.plane_strain_modulus(),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -513,5 +538,33 @@ mod tests {
         approx::assert_relative_eq!(al.dundurs_beta(), 0.4 / 1.4, max_relative = 1e-12);
         let back = IsotropicConstants::from_youngs(al.youngs_modulus(), 0.3);
         approx::assert_relative_eq!(back.shear_modulus, al.shear_modulus, max_relative = 1e-12);
+    }
+
+    /// The open-circuit bulk state solves the constitutive law: with εxx = s̃σB and the εzz, Ez
+    /// it implies, σzz = 0 and Dz = 0 to round-off; the isotropic limit is (1 − ν²)/E; and the
+    /// open-circuit compliance of PZT-4 lies between the short-circuit (Ez = 0) one and the
+    /// purely elastic one of its stiffness (the coupling stiffens it).
+    #[test]
+    fn bulk_compliance_open_circuit_state_and_isotropic_limit() {
+        let al = Material::Elastic(ALUMINIUM);
+        approx::assert_relative_eq!(
+            al.bulk_compliance(),
+            (1.0 - 0.09) / ALUMINIUM.youngs_modulus(),
+            max_relative = 1e-14
+        );
+        let c = PZT4;
+        let s = Material::Piezoelectric(c).bulk_compliance();
+        let exx = s * 1e6;
+        let det = c.c33 * c.eps33 + c.e33 * c.e33;
+        let ezz = -(c.c13 * c.eps33 + c.e33 * c.e31) * exx / det;
+        let field = (c.c13 * c.e33 - c.c33 * c.e31) * exx / det;
+        let sxx = c.c11 * exx + c.c13 * ezz - c.e31 * field;
+        let szz = c.c13 * exx + c.c33 * ezz - c.e33 * field;
+        let dz = c.e31 * exx + c.e33 * ezz + c.eps33 * field;
+        approx::assert_relative_eq!(sxx, 1e6, max_relative = 1e-12);
+        assert!(szz.abs() < 1e-12 * 1e6, "{szz}");
+        assert!(dz.abs() < 1e-12 * (c.e33 * exx).abs(), "{dz}");
+        let short = 1.0 / (c.c11 - c.c13 * c.c13 / c.c33);
+        assert!(s < short, "{s} {short}");
     }
 }

@@ -594,6 +594,7 @@ fn record_of(
         t,
         q: s.tangential_load,
         normal_load: s.normal_load,
+        bulk_stress: 0.0,
         charge: s.charge,
         potential: s.potential.unwrap_or(0.0),
         regime,

@@ -315,6 +315,7 @@ pub fn loads_of(model: &ContactModel, normal_load: f64, q: f64) -> Loads {
         normal: normal_load,
         tangential: q,
         electric,
+        bulk_stress: 0.0,
     }
 }
 
@@ -515,6 +516,7 @@ impl GeneralRun {
             tangential: q,
             normal: punch.map_or(old.loads.normal, |p| p.normal),
             electric: punch.map_or(old.loads.electric, |p| p.electric),
+            bulk_stress: punch.map_or(old.loads.bulk_stress, |p| p.bulk_stress),
         };
         let moves = PunchLoads::of(loads.normal, loads.electric)
             != PunchLoads::of(old.loads.normal, old.loads.electric);
@@ -642,6 +644,7 @@ impl GeneralRun {
             t,
             q: s.loads.tangential,
             normal_load: s.loads.normal,
+            bulk_stress: s.loads.bulk_stress,
             charge: s.resultants().2,
             potential: s.potential,
             regime,

@@ -5,8 +5,9 @@
 //!
 //! # Steps
 //! A segment from point k to point k + 1 is cut into
-//! `n = max(steps_per_segment, ⌈max(|ΔQ|, η|ΔP|)/max_step⌉)` equal steps; a segment along which
-//! no load changes is one step (a hold). The run begins with a ramp from the end of normal
+//! `n = max(steps_per_segment, ⌈max(|ΔQ|, η|ΔP|)/max_step⌉)` equal steps (`steps_per_segment`
+//! where only the electric load or the bulk stress σB changes); a segment along which no load
+//! changes is one step (a hold). The run begins with a ramp from the end of normal
 //! loading (Q = 0, P and the electric load of the normal loading) to the first point, cut by
 //! the same rule, when the first point differs from it.
 
@@ -96,7 +97,10 @@ impl LoadHistory {
     /// Steps from loads `a` to loads `b` (module docs).
     fn steps_between(&self, a: (f64, Option<PunchLoads>), b: (f64, Option<PunchLoads>)) -> usize {
         let (dp, de) = match (a.1, b.1) {
-            (Some(x), Some(y)) => (y.normal - x.normal, y.electric - x.electric),
+            (Some(x), Some(y)) => (
+                y.normal - x.normal,
+                (y.electric - x.electric).abs() + (y.bulk_stress - x.bulk_stress).abs(),
+            ),
             _ => (0.0, 0.0),
         };
         let eta = self.punch.as_ref().map_or(0.0, |h| h.friction);
@@ -114,6 +118,13 @@ impl LoadHistory {
         } else {
             1
         }
+    }
+
+    /// Whether the bulk stress σB is not zero at some point.
+    pub fn has_bulk_stress(&self) -> bool {
+        self.punch
+            .as_ref()
+            .is_some_and(|h| h.points.iter().any(|p| p.bulk_stress != 0.0))
     }
 
     /// Steps of the ramp from the end of normal loading to the first point (0 when it is there).
@@ -316,6 +327,7 @@ fn between(
         (Some(x), Some(y)) => Some(PunchLoads {
             normal: mix(x.normal, y.normal),
             electric: mix(x.electric, y.electric),
+            bulk_stress: mix(x.bulk_stress, y.bulk_stress),
         }),
         _ => None,
     };
@@ -344,13 +356,33 @@ pub struct PunchLoads {
     /// Γ (C/m) under a charge-controlled conducting punch, φ0 (V) under a potential-controlled
     /// one; 0 otherwise.
     pub electric: f64,
+    /// The bulk stress σB of the half-plane (Pa, tension positive; 0 at the end of normal
+    /// loading), [`crate::contact::general::Loads::bulk_stress`].
+    #[serde(skip_serializing_if = "is_zero")]
+    pub bulk_stress: f64,
+}
+
+fn is_zero(value: &f64) -> bool {
+    *value == 0.0
 }
 
 impl PunchLoads {
-    /// The loads P and `electric`; two are equal when both values are (a load held constant
-    /// along a history is the same number at every step).
+    /// The loads P and `electric` with no bulk stress; two are equal when every value is (a
+    /// load held constant along a history is the same number at every step).
     pub fn of(normal: f64, electric: f64) -> Self {
-        Self { normal, electric }
+        Self {
+            normal,
+            electric,
+            bulk_stress: 0.0,
+        }
+    }
+
+    /// The same loads with the bulk stress σB (Pa).
+    pub fn with_bulk_stress(self, bulk_stress: f64) -> Self {
+        Self {
+            bulk_stress,
+            ..self
+        }
     }
 }
 

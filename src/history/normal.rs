@@ -256,6 +256,7 @@ fn steps(
             normal: full.normal * f * f,
             tangential: 0.0,
             electric: full.electric * f * f,
+            bulk_stress: 0.0,
         };
         let (next, report) = solver.step(&state, loads)?;
         iterations += report.outer_iterations;

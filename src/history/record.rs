@@ -27,6 +27,9 @@ pub struct StepRecord {
     pub q: f64,
     /// Normal load P (N/m).
     pub normal_load: f64,
+    /// Bulk stress σB of the half-plane (Pa; absent where zero).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub bulk_stress: f64,
     /// Resultant charge Γ on a conducting punch (C/m; 0 without one).
     pub charge: f64,
     /// Potential φ0 of a conducting punch (V; 0 without one).
@@ -227,4 +230,8 @@ impl std::fmt::Display for StepFailure {
             self.step, self.t, self.q, self.regime
         )
     }
+}
+
+fn is_zero(value: &f64) -> bool {
+    *value == 0.0
 }

@@ -296,11 +296,14 @@ fn keep(records: &mut Vec<StepRecord>, record: StepRecord, all: bool) {
     records.push(record);
 }
 
-/// Whether the step to `point` changes the normal or the electric load of the state.
+/// Whether the step to `point` changes the normal or the electric load or the bulk stress of
+/// the state.
 fn moves_the_punch(model: &ContactModel, state: &HistoryState, point: LoadPoint) -> bool {
     match (&state.general, &state.driver) {
         (Some(run), _) => point.punch.is_some_and(|punch| {
-            punch != PunchLoads::of(run.state.loads.normal, run.state.loads.electric)
+            punch
+                != PunchLoads::of(run.state.loads.normal, run.state.loads.electric)
+                    .with_bulk_stress(run.state.loads.bulk_stress)
         }),
         (None, Some(driver)) => moves_the_punch_from(model, driver, point),
         (None, None) => unreachable!("a run state holds a driver or a general run"),

@@ -89,17 +89,20 @@ pub(crate) struct StepsCsv<W: std::io::Write> {
     writer: csv::Writer<W>,
     block: Vec<StepRecord>,
     friction: f64,
+    bulk: bool,
 }
 
 impl<W: std::io::Write> StepsCsv<W> {
-    /// Write the header to `out`; `friction` is η.
-    pub(crate) fn new(out: W, friction: f64) -> std::io::Result<Self> {
+    /// Write the header to `out`; `friction` is η, `bulk` whether the history has a bulk
+    /// stress (the column `bulk_stress_Pa`).
+    pub(crate) fn new(out: W, friction: f64, bulk: bool) -> std::io::Result<Self> {
         let mut writer = csv::Writer::from_writer(out);
-        steps_table(&[], friction).write_header(&mut writer)?;
+        steps_table_of(&[], friction, bulk).write_header(&mut writer)?;
         Ok(Self {
             writer,
             block: Vec::with_capacity(STEPS_BLOCK),
             friction,
+            bulk,
         })
     }
 
@@ -113,7 +116,7 @@ impl<W: std::io::Write> StepsCsv<W> {
     }
 
     fn write_block(&mut self) -> std::io::Result<()> {
-        steps_table(&self.block, self.friction).write_rows(&mut self.writer)?;
+        steps_table_of(&self.block, self.friction, self.bulk).write_rows(&mut self.writer)?;
         self.block.clear();
         Ok(())
     }
@@ -209,8 +212,23 @@ fn word<T: serde::Serialize>(value: &T) -> String {
         .unwrap_or_default()
 }
 
-/// `steps.csv`: one row per accepted step; `friction` is η.
+/// `steps.csv`: one row per accepted step; `friction` is η. The column `bulk_stress_Pa`
+/// (after `potential_V`) is there when a record has a bulk stress.
 pub fn steps_table(records: &[StepRecord], friction: f64) -> Table {
+    let bulk = records.iter().any(|r| r.bulk_stress != 0.0);
+    steps_table_of(records, friction, bulk)
+}
+
+/// [`steps_table`] with the column `bulk_stress_Pa` where `bulk` is true.
+pub(crate) fn steps_table_of(records: &[StepRecord], friction: f64, bulk: bool) -> Table {
+    let mut table = all_steps_columns(records, friction);
+    if !bulk {
+        table.columns.retain(|(name, _)| *name != "bulk_stress_Pa");
+    }
+    table
+}
+
+fn all_steps_columns(records: &[StepRecord], friction: f64) -> Table {
     let r = records;
     let regime = |r: &StepRecord| word(&r.regime);
     Table {
@@ -222,6 +240,7 @@ pub fn steps_table(records: &[StepRecord], friction: f64) -> Table {
             ("P_N_per_m", real(r, |r| r.normal_load)),
             ("charge_C_per_m", real(r, |r| r.charge)),
             ("potential_V", real(r, |r| r.potential)),
+            ("bulk_stress_Pa", real(r, |r| r.bulk_stress)),
             ("regime", Column::Text(r.iter().map(regime).collect())),
             ("phase", Column::Count(r.iter().map(|r| r.phase).collect())),
             ("a_m", real(r, |r| r.half_width)),
@@ -283,7 +302,7 @@ mod tests {
             .collect();
         assert!(records.len() > 2 * STEPS_BLOCK);
         let friction = scenario.model.friction;
-        let mut csv = StepsCsv::new(Vec::new(), friction).unwrap();
+        let mut csv = StepsCsv::new(Vec::new(), friction, false).unwrap();
         for r in &records {
             csv.push(r).unwrap();
         }

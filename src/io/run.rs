@@ -250,7 +250,14 @@ impl Digest {
             h.points.iter().map(|p| p.1.abs()).fold(0.0, f64::max)
         });
         let steps = match steps {
-            Some((path, out)) => match StepsCsv::new(out, scenario.model.friction) {
+            Some((path, out)) => match StepsCsv::new(
+                out,
+                scenario.model.friction,
+                scenario
+                    .history
+                    .as_ref()
+                    .is_some_and(|h| h.has_bulk_stress()),
+            ) {
                 Ok(csv) => Some((path, csv)),
                 Err(source) => return Err(Error::WriteOutput { path, source }),
             },
@@ -526,6 +533,13 @@ pub(crate) fn solve_from<'a>(
             .map_err(|e| warnings.push(format!("the fields below the surface are not written: {e}")))
             .ok()
     });
+    if subsurface.is_some() && scenario.history.as_ref().is_some_and(|h| h.has_bulk_stress()) {
+        warnings.push(
+            "the fields below the surface are those of the contact's tractions and charge: \
+             the uniform state of the bulk stress σB (σxx = σB) is not in them"
+                .to_string(),
+        );
+    }
     if let Some(out) = &subsurface
         && !out.has_von_mises()
     {

@@ -207,16 +207,29 @@ pub fn validate(raw: RawScenario) -> Result<Scenario, Vec<Issue>> {
         });
         resolve_history(&mut issues, h, (raw.friction, raw.normal_load), electric)
     });
-    let varies = history
+    let punch = history
         .as_ref()
         .and_then(|h| h.history.as_ref())
-        .and_then(|h| h.punch.as_ref())
-        .is_some_and(|p| p.points.iter().any(|&loads| loads != p.start));
+        .and_then(|h| h.punch.as_ref());
+    let varies = punch.is_some_and(|p| {
+        p.points
+            .iter()
+            .any(|&loads| crate::history::PunchLoads::of(loads.normal, loads.electric) != p.start)
+    });
+    let stressed = punch.is_some_and(|p| p.points.iter().any(|loads| loads.bulk_stress != 0.0));
     if varies && raw.numerics.solver == crate::history::SolverChoice::Spectral {
         issues.push(Issue::new(
             "numerics.solver",
             "\"spectral\" is invalid with a history that changes P or the electric load; it must be \
              \"auto\" or \"general\" (the spectral solver holds them fixed)",
+        ));
+    }
+    if stressed && raw.numerics.solver == crate::history::SolverChoice::Spectral {
+        issues.push(Issue::new(
+            "numerics.solver",
+            "\"spectral\" is invalid with a history that has a bulk stress \
+             (`tangential_history.bulk_stress`); it must be \"auto\" or \"general\" (the spectral \
+             solver holds σB = 0)",
         ));
     }
     // A punch off the half-plane (P = 0) carries no charge to it.

@@ -232,6 +232,23 @@ pub struct RawHistory {
     /// Largest load step, in the unit of Q (> 0, default 0.05 ηP).
     #[serde(default)]
     pub max_step: Option<f64>,
+    /// The bulk stress σB (Pa) of the half-plane at each point of `points` and `cycle`
+    /// (none: σB = 0 throughout).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bulk_stress: Option<RawBulkStress>,
+}
+
+/// The bulk stress σB (Pa, tension positive) at the points of a history: one value per point
+/// of `points` and one per point of `cycle`, linear in t between them like the other loads,
+/// from σB = 0 at the end of normal loading.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawBulkStress {
+    /// σB at each point of `tangential_history.points` (Pa).
+    pub points: Vec<f64>,
+    /// σB at each point of `tangential_history.cycle` (Pa).
+    #[serde(default)]
+    pub cycle: Vec<f64>,
 }
 
 pub(super) fn default_repeats() -> usize {

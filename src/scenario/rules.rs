@@ -440,24 +440,33 @@ pub(super) fn resolve_history(
             span: h.span(),
         };
     }
-    let start = PunchLoads {
-        normal: normal_load,
-        electric: electric.unwrap_or(0.0),
-    };
-    let punch_of = |p: &[f64]| PunchLoads {
+    let start = PunchLoads::of(normal_load, electric.unwrap_or(0.0));
+    let bulk = validate_bulk_stress(issues, h);
+    let bulk_at =
+        |values: Option<&Vec<f64>>, i: usize| values.and_then(|v| v.get(i)).copied().unwrap_or(0.0);
+    let punch_of = |p: &[f64], bulk_stress: f64| PunchLoads {
         normal: column(p, 2, start.normal),
         electric: column(p, 3, start.electric),
+        bulk_stress,
     };
     let time = |p: &[f64]| column(p, 0, 0.0);
     let lead: Vec<(f64, f64)> = h.points.iter().map(|p| (time(p), q_of(p))).collect();
     let cycle: Vec<(f64, f64)> = h.cycle.iter().map(|p| (time(p), q_of(p))).collect();
     let repeats = if cycle.is_empty() { 0 } else { h.repeats };
     let points = LoadHistory::with_cycles(&lead, &cycle, repeats);
-    let punch = (columns > 2).then(|| {
-        let lead: Vec<(f64, PunchLoads)> =
-            h.points.iter().map(|p| (time(p), punch_of(p))).collect();
-        let cycle: Vec<(f64, PunchLoads)> =
-            h.cycle.iter().map(|p| (time(p), punch_of(p))).collect();
+    let punch = (columns > 2 || bulk.is_some()).then(|| {
+        let lead: Vec<(f64, PunchLoads)> = h
+            .points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (time(p), punch_of(p, bulk_at(bulk.map(|b| &b.points), i))))
+            .collect();
+        let cycle: Vec<(f64, PunchLoads)> = h
+            .cycle
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (time(p), punch_of(p, bulk_at(bulk.map(|b| &b.cycle), i))))
+            .collect();
         PunchHistory {
             start,
             points: LoadHistory::with_cycles(&lead, &cycle, repeats)
@@ -489,6 +498,46 @@ pub(super) fn resolve_history(
         span,
     }
 }
+
+/// The bulk stress of a history, when it has one: one finite value (|σB| ≤ 1e14 Pa) per point
+/// of `points` and of `cycle`. `None` where there is none (and where it breaks a rule: the
+/// issues say which).
+fn validate_bulk_stress<'h>(
+    issues: &mut Vec<Issue>,
+    h: &'h RawHistory,
+) -> Option<&'h RawBulkStress> {
+    let bulk = h.bulk_stress.as_ref()?;
+    let before = issues.len();
+    for (name, values, count) in [
+        ("points", &bulk.points, h.points.len()),
+        ("cycle", &bulk.cycle, h.cycle.len()),
+    ] {
+        if values.len() != count {
+            issues.push(Issue::new(
+                format!("tangential_history.bulk_stress.{name}"),
+                format!(
+                    "{} values is invalid; it must have one per point of \
+                     `tangential_history.{name}` ({count})",
+                    values.len()
+                ),
+            ));
+        }
+        for (i, v) in values.iter().enumerate() {
+            if !(v.is_finite() && v.abs() <= MAX_BULK_STRESS) {
+                issues.push(Issue::new(
+                    format!("tangential_history.bulk_stress.{name}[{i}]"),
+                    format!(
+                        "{v:e} Pa is invalid; it must be finite with |σB| ≤ {MAX_BULK_STRESS:e} Pa"
+                    ),
+                ));
+            }
+        }
+    }
+    (issues.len() == before).then_some(bulk)
+}
+
+/// The largest bulk stress |σB| (Pa), the largest stiffness a material may have.
+const MAX_BULK_STRESS: f64 = 1e14;
 
 /// The cycle's times: strictly increasing and > 0.
 pub(super) fn validate_cycle(issues: &mut Vec<Issue>, cycle: &[Vec<f64>]) {

@@ -239,7 +239,7 @@ const FATIGUE_ELECTRIC: &str = ",d_x_range_C_per_m2,e_x_range_V_per_m";
 
 /// A CSV file's header and its data rows as numbers (non-numeric cells, such as the regime,
 /// become NaN).
-fn read_csv(path: &Path) -> (String, Vec<Vec<f64>>) {
+pub(crate) fn read_csv(path: &Path) -> (String, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut lines = text.lines();
     let header = lines.next().unwrap().to_string();
@@ -520,8 +520,9 @@ fn run_scenario(name: &str) -> (tempfile::TempDir, PathBuf, Summary) {
 }
 
 /// The scenarios with a test of their own below; a file in `scenarios/` without one fails.
-const SCENARIOS: [&str; 19] = [
+const SCENARIOS: [&str; 20] = [
     "baseline",
+    "bulk_stress",
     "charge_history",
     "cattaneo_mindlin_uncoupled",
     "displacement_gross_slip",
@@ -620,7 +621,7 @@ fn scenario_small_friction_below_gamma1() {
 }
 
 /// The column of `steps.csv` named `name`.
-fn column(header: &str, rows: &[Vec<f64>], name: &str) -> Vec<f64> {
+pub(crate) fn column(header: &str, rows: &[Vec<f64>], name: &str) -> Vec<f64> {
     let k = header.split(',').position(|c| c == name).unwrap();
     rows.iter().map(|r| r[k]).collect()
 }

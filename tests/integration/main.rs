@@ -1,6 +1,7 @@
 //! The one integration-test binary: reference solutions, scenarios and the command line.
 
 mod accelerations;
+mod bulk_stress;
 mod cli;
 mod fatigue;
 mod fuzz;

@@ -130,7 +130,7 @@ impl Solver {
         let n = mesh.len();
         let c = &self.coefficients;
         let (y23, y33, w13) = c.electric.unwrap_or((0.0, 0.0, 0.0));
-        let fixed = self.fixed_displacement(&pressure, &charge);
+        let fixed = self.fixed_displacement(&pressure, &charge, loads.bulk_stress);
         let (mut lp, mut lq, mut lg, mut sq) =
             (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         self.influence.log_apply(&pressure, &mut lp);
@@ -182,7 +182,8 @@ impl Solver {
     }
 
     /// p, q, g, σxx0 and Dx0 of an element state at x (module docs); zero fields outside the
-    /// mesh's elements in contact.
+    /// mesh's elements in contact. σxx0 includes the bulk stress σB of the state's loads (the
+    /// uniform state adds `σxx = σB` and nothing to Dx).
     pub fn surface_point(
         &self,
         model: &ContactModel,
@@ -213,7 +214,9 @@ impl Solver {
         );
         let strain = -c.w12 * p - w13 * g + c.y11 * cauchy(&state.shear);
         let gradient = w13 * q + y23 * cauchy(&state.pressure) + y33 * cauchy(&state.charge);
-        model.surface_fields(x, (p, q, g), strain, gradient)
+        let mut point = model.surface_fields(x, (p, q, g), strain, gradient);
+        point.sigma_xx += state.loads.bulk_stress;
+        point
     }
 }
 
@@ -255,6 +258,7 @@ mod tests {
             normal: 2000.0,
             tangential: q,
             electric: 6e-7,
+            bulk_stress: 0.0,
         }
     }
 

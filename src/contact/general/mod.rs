@@ -105,6 +105,29 @@
 //! result. The box alone always has a minimiser, also with every element at its bound: gross
 //! slip, Q = ±ηP, where the displacement exceeds what the stick zone can hold.
 //!
+//! # Bulk stress
+//! A bulk stress σB ([`Loads::bulk_stress`], tension positive) is a uniform `σxx = σB` of the
+//! half-plane, the specimen's load in a fretting-fatigue test. It adds a uniform surface strain
+//! `εB = s̃ σB` ([`crate::material::Material::bulk_compliance`]: `(1 − ν²)/E` for an isotropic
+//! solid; for a piezoelectric one the open-circuit state `σzz = σxz = 0`, `Dz = 0`, whose
+//! surface potential is uniform, so a conducting punch's condition is unchanged) and so the
+//! displacement `ux = εB x` (x from the punch axis; the constant is the datum's, which δx
+//! absorbs) to every point, and nothing to `uz` or φ on the surface:
+//!
+//! ```text
+//! Ux_i += εB (x2² − x1²)/2
+//! ```
+//!
+//! A change of σB in a step then moves the linear term `c` of the tangential programme by
+//! `ΔεB ∫x dx` per element, so an element's slip increment gains `ΔεB x̄_i` (its centre
+//! x̄_i) while δx keeps its meaning. The punch is rigid, so only the half-plane stretches: on
+//! the uncoupled half-plane (ν = ½) a stick zone `|x − e| ≤ c` under Q with
+//! `q = ηp0[√(1 − x²/a²) − (c/a)√(1 − (x − e)²/c²)]` has the q-part of its surface strain
+//! `−y11 ηp0 e/a` uniform (`y11 = 2(1 − ν²)/E`), and stick (no change of strain since the
+//! pressing) needs `y11 ηp0 e/a = εB`: `e = aσB/(2ηp0)`, towards +x for tension, half
+//! Nowell and Hills' `aσB/(4ηp0)` for two similar elastic bodies, whose pad strains too
+//! ([`crate::analytical::BulkStressCattaneo`]).
+//!
 //! # Alternation
 //! When q changes p or g (`w12 ≠ 0`, or `w13 ≠ 0` under a conducting punch, and full
 //! coupling), the two subproblems alternate until p and q change by less than
@@ -214,6 +237,15 @@ pub struct Loads {
     /// Γ (C/m) for [`Electrode::ConductingCharge`], φ0 (V) for
     /// [`Electrode::ConductingPotential`], unused otherwise.
     pub electric: f64,
+    /// The bulk stress σB (Pa, tension positive): a uniform σxx of the half-plane, the
+    /// specimen's load in a fretting-fatigue test (module docs, *Bulk stress*). Absent from a
+    /// serialised state where it is zero.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub bulk_stress: f64,
+}
+
+fn is_zero(value: &f64) -> bool {
+    *value == 0.0
 }
 
 /// How the tangential loading of a step is prescribed.
@@ -288,6 +320,9 @@ pub(crate) struct Coefficients {
     pub coupled: bool,
     pub friction: f64,
     pub profile: crate::contact::Profile,
+    /// The plane-strain compliance of a uniform bulk stress, `εB = s̃ σB` (1/Pa,
+    /// [`crate::material::Material::bulk_compliance`]).
+    pub bulk: f64,
 }
 
 /// The solver for one model and mesh: the influence matrices, built once.
@@ -321,6 +356,7 @@ impl GeneralState {
                 normal: 0.0,
                 tangential: 0.0,
                 electric: 0.0,
+                bulk_stress: 0.0,
             },
         }
     }
@@ -385,6 +421,7 @@ impl Solver {
             coupled: model.coupling == Coupling::Full,
             friction: model.friction,
             profile: model.profile.clone(),
+            bulk: model.material.bulk_compliance(),
         };
         let influence = Influence::new(&mesh, model.reference_distance);
         Self {
@@ -553,7 +590,7 @@ impl Solver {
             let (q_new, tangential) = self.tangential(
                 previous,
                 &normal,
-                (total, shift),
+                (total, shift, loads.bulk_stress),
                 (&q, &p_start),
                 &mut work,
             )?;
@@ -607,8 +644,9 @@ struct Tangential {
 }
 
 impl Solver {
-    /// The displacement `∫ux` per element of the pressure and charge (module docs, (U)).
-    fn fixed_displacement(&self, pressure: &[f64], charge: &[f64]) -> Vec<f64> {
+    /// The displacement `∫ux` per element of the pressure and charge (module docs, (U)) and
+    /// of the bulk stress `bulk_stress` (module docs, *Bulk stress*).
+    fn fixed_displacement(&self, pressure: &[f64], charge: &[f64], bulk_stress: f64) -> Vec<f64> {
         let n = self.mesh.len();
         let c = &self.coefficients;
         let mut sp = vec![0.0; n];
@@ -619,6 +657,13 @@ impl Solver {
             self.influence.sign_apply(charge, &mut sg);
             for (o, v) in out.iter_mut().zip(&sg) {
                 *o -= 0.5 * w13 * v;
+            }
+        }
+        if bulk_stress != 0.0 {
+            let strain = c.bulk * bulk_stress;
+            for (i, o) in out.iter_mut().enumerate() {
+                let (x1, x2) = (self.mesh.edges[i], self.mesh.edges[i + 1]);
+                *o += strain * 0.5 * (x2 * x2 - x1 * x1);
             }
         }
         out
@@ -632,7 +677,7 @@ impl Solver {
         &self,
         previous: &GeneralState,
         normal: &NormalSolution,
-        (total, shift): (Option<f64>, f64),
+        (total, shift, bulk_stress): (Option<f64>, f64, f64),
         (start, start_pressure): (&[f64], &[f64]),
         work: &mut Workspace,
     ) -> Result<(Vec<f64>, Tangential), SolveFailure> {
@@ -658,7 +703,7 @@ impl Solver {
             out.shift = shift;
             return Ok((q, out));
         }
-        let fixed = self.fixed_displacement(&normal.pressure, &normal.charge);
+        let fixed = self.fixed_displacement(&normal.pressure, &normal.charge, bulk_stress);
         // K on the contact elements, kept while the contact set stays.
         let k = match work.stiffness.take() {
             Some((set, k)) if set == act => k,
@@ -728,7 +773,8 @@ impl Solver {
     ) -> GeneralState {
         let n = self.mesh.len();
         let c = &self.coefficients;
-        let mut ux = self.fixed_displacement(&normal.pressure, &normal.charge);
+        let mut ux =
+            self.fixed_displacement(&normal.pressure, &normal.charge, loads.bulk_stress);
         let mut lq = vec![0.0; n];
         self.influence.log_apply(&shear, &mut lq);
         for (i, u) in ux.iter_mut().enumerate() {

@@ -216,6 +216,7 @@ mod tests {
             normal: 2000.0,
             tangential: 0.0,
             electric: 6e-7,
+            bulk_stress: 0.0,
         };
         let (pressed, _) = solver
             .step(&GeneralState::unloaded(mesh.clone()), normal)

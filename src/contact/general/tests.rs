@@ -69,6 +69,7 @@ fn loads(normal: f64, tangential: f64) -> Loads {
         normal,
         tangential,
         electric: 0.0,
+        bulk_stress: 0.0,
     }
 }
 
@@ -315,6 +316,7 @@ fn pzt4_conducting_punch_zhou_lee_and_baseline_stick_zone() {
         normal: p * f,
         tangential: 0.0,
         electric: gamma * f,
+        bulk_stress: 0.0,
     };
     for end in [4e-3, 2e-3, 1e-3] {
         let solver = Solver::new(&model(0.0), graded(a, end, 10.0 * end), Options::default());
@@ -395,6 +397,7 @@ fn smooth_pressure_at_the_contact_ends_below_gamma1() {
                 normal: p * f,
                 tangential: 0.0,
                 electric: gamma * f,
+                bulk_stress: 0.0,
             };
             s = solver.step(&s, loads).unwrap().0;
         }
@@ -503,6 +506,7 @@ fn coupled_reversal_forms_old_direction_layers_at_the_ends() {
         normal: p * f,
         tangential: q * eta * p,
         electric: gamma * f,
+        bulk_stress: 0.0,
     };
     let mut s = GeneralState::unloaded(solver.mesh().clone());
     let steps = (5f64.ln() / 1.05f64.ln()).ceil() as i32;
@@ -552,6 +556,7 @@ fn potential_control_and_insulating_punch() {
         normal: p,
         tangential: 0.1 * 0.3 * p,
         electric,
+        bulk_stress: 0.0,
     };
     let solver = Solver::new(&charged, mesh.clone(), Options::default());
     let (s, _) = solver.step(&unloaded, at(gamma)).unwrap();
@@ -927,3 +932,4 @@ fn a_state_carried_onto_another_mesh_keeps_its_displacement_and_resultants() {
 }
 
 mod drive;
+mod bulk;
