@@ -533,13 +533,6 @@ pub(crate) fn solve_from<'a>(
             .map_err(|e| warnings.push(format!("the fields below the surface are not written: {e}")))
             .ok()
     });
-    if subsurface.is_some() && scenario.history.as_ref().is_some_and(|h| h.has_bulk_stress()) {
-        warnings.push(
-            "the fields below the surface are those of the contact's tractions and charge: \
-             the uniform state of the bulk stress σB (σxx = σB) is not in them"
-                .to_string(),
-        );
-    }
     if let Some(out) = &subsurface
         && !out.has_von_mises()
     {

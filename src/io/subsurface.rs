@@ -128,15 +128,22 @@ impl SubsurfaceOutput {
     /// The fields under a state: a spectral state's densities on the composite rule of
     /// [`SurfaceLoads::of_state`], an element state's constant on its elements.
     pub(crate) fn map(&self, state: &SolvedState) -> Result<SubsurfaceMap, SubsurfaceError> {
-        let loads = match state {
-            SolvedState::Spectral(s) => SurfaceLoads::of_state(s, DEFAULT_PANELS_PER_HALF)?,
-            SolvedState::General(_, s) => SurfaceLoads::of_elements(s)?,
+        let (loads, bulk_stress) = match state {
+            SolvedState::Spectral(s) => (SurfaceLoads::of_state(s, DEFAULT_PANELS_PER_HALF)?, 0.0),
+            SolvedState::General(_, s) => (SurfaceLoads::of_elements(s)?, s.loads.bulk_stress),
         };
         let points = self.grid.points();
-        let chunks = points
+        let mut chunks = points
             .par_chunks(CHUNK)
             .map(|chunk| subsurface_fields(&self.kernel, &loads, chunk))
             .collect::<Result<Vec<_>, _>>()?;
+        // The uniform state of a bulk stress, added to the contact's fields.
+        if bulk_stress != 0.0 {
+            let bulk = self.kernel.bulk_state(bulk_stress);
+            for p in chunks.iter_mut().flatten() {
+                *p = p.with_bulk(bulk_stress, &bulk);
+            }
+        }
         Ok(SubsurfaceMap {
             grid: self.grid.clone(),
             points: chunks.into_iter().flatten().collect(),

@@ -617,6 +617,63 @@ impl SubsurfacePoint {
     }
 }
 
+/// The uniform state of a bulk stress σB along the surface (`general::Loads::bulk_stress`):
+/// `σxx = σB`, `σzz = σxz = 0`, `εyy = 0`, and for a piezoelectric solid open circuit,
+/// `Dz = 0` and `Ex = Dx = 0` ([`crate::material::Material::bulk_compliance`]). From
+/// `σzz = c13 εxx + c33 εzz − e33 Ez = 0` and `Dz = e31 εxx + e33 εzz + ε33 Ez = 0`,
+///
+/// ```text
+/// εzz = −(ε33 c13 + e33 e31) εxx/Δ,   Ez = (e33 c13 − c33 e31) εxx/Δ,   Δ = c33 ε33 + e33²,
+/// σyy = c12 εxx + c13 εzz − e31 Ez                (isotropic: σyy = ν σB, Ez = 0).
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BulkState {
+    /// εxx = s̃σB and εzz (–) of a piezoelectric solid (the isotropic state needs none).
+    pub strains: Option<(f64, f64)>,
+    /// σyy (Pa), when c12 is known.
+    pub sigma_yy: Option<f64>,
+    /// Ez (V/m).
+    pub e_z: f64,
+}
+
+impl SubsurfaceKernel {
+    /// The uniform state of the bulk stress `sigma_b` (Pa) in this kernel's solid.
+    pub fn bulk_state(&self, sigma_b: f64) -> BulkState {
+        match &self.kind {
+            Kind::Isotropic { poisson_ratio } => BulkState {
+                strains: None,
+                sigma_yy: Some(poisson_ratio * sigma_b),
+                e_z: 0.0,
+            },
+            Kind::Piezoelectric {
+                constants: c, c12, ..
+            } => {
+                let exx = sigma_b * crate::material::Material::Piezoelectric(*c).bulk_compliance();
+                let det = c.c33 * c.eps33 + c.e33 * c.e33;
+                let ezz = -(c.eps33 * c.c13 + c.e33 * c.e31) * exx / det;
+                let e_z = (c.e33 * c.c13 - c.c33 * c.e31) * exx / det;
+                BulkState {
+                    strains: Some((exx, ezz)),
+                    sigma_yy: c12.map(|c12| c12 * exx + c.c13 * ezz - c.e31 * e_z),
+                    e_z,
+                }
+            }
+        }
+    }
+}
+
+impl SubsurfacePoint {
+    /// The point with the uniform state of a bulk stress `sigma_b` added ([`BulkState`]).
+    pub fn with_bulk(&self, sigma_b: f64, bulk: &BulkState) -> Self {
+        Self::new(
+            (self.x, self.z),
+            [self.sigma_xx + sigma_b, self.sigma_zz, self.sigma_xz],
+            self.sigma_yy.zip(bulk.sigma_yy).map(|(s, b)| s + b),
+            [self.d_x, self.d_z, self.e_x, self.e_z + bulk.e_z],
+        )
+    }
+}
+
 /// The fields at each of `points` (x, z) (m, z > 0) under `loads` (module docs).
 pub fn subsurface_fields(
     kernel: &SubsurfaceKernel,

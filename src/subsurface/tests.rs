@@ -701,3 +701,41 @@ fn points_on_or_above_the_surface_and_bad_samples_are_errors() {
     }
     assert!(SurfaceRule::new(0.0, 1.0, &[], 0).is_none());
 }
+
+/// The uniform state of a bulk stress: on PZT-4 (c12 of the preset) the constitutive law
+/// (stiffness at constant field) gives back σxx = σB, σzz = 0 and Dz = 0 from the state's
+/// εxx, εzz and Ez, with εxx the solver's open-circuit compliance times σB; on an isotropic
+/// solid σyy = νσB. Added to a point, it shifts σxx by σB and σyy and Ez by the state's, and
+/// the von Mises stress follows.
+#[test]
+fn the_bulk_state_is_traction_and_charge_free_and_carries_sigma_b() {
+    let sigma_b = 5e6;
+    let kernel =
+        SubsurfaceKernel::try_new(&Material::Piezoelectric(crate::material::PZT4)).unwrap();
+    let state = kernel.bulk_state(sigma_b);
+    let c = crate::material::PZT4;
+    let (exx, ezz) = state.strains.unwrap();
+    let ez = state.e_z;
+    let sxx = c.c11 * exx + c.c13 * ezz - c.e31 * ez;
+    let szz = c.c13 * exx + c.c33 * ezz - c.e33 * ez;
+    let dz = c.e31 * exx + c.e33 * ezz + c.eps33 * ez;
+    assert!((sxx / sigma_b - 1.0).abs() < 1e-12, "{sxx}");
+    assert!(szz.abs() < 1e-12 * sigma_b, "{szz}");
+    assert!(dz.abs() < 1e-12 * (c.e33 * exx).abs(), "{dz}");
+    let compliance = Material::Piezoelectric(c).bulk_compliance();
+    assert!((exx / (compliance * sigma_b) - 1.0).abs() < 1e-14);
+    let c12 = preset_c12(&c).unwrap();
+    let syy = c12 * exx + c.c13 * ezz - c.e31 * ez;
+    assert!((state.sigma_yy.unwrap() / syy - 1.0).abs() < 1e-14);
+    let iso = aluminium().bulk_state(sigma_b);
+    let nu = ALUMINIUM.poisson_ratio;
+    assert!((iso.sigma_yy.unwrap() - nu * sigma_b).abs() < 1e-9 && iso.e_z == 0.0);
+    let p = SubsurfacePoint::new((0.0, 1e-5), [-1e7, -2e7, 3e6], Some(-9e6), [0.0; 4]);
+    let q = p.with_bulk(sigma_b, &iso);
+    assert!((q.sigma_xx - (-1e7 + sigma_b)).abs() < 1e-6);
+    assert!((q.sigma_yy.unwrap() - (-9e6 + nu * sigma_b)).abs() < 1e-6);
+    let (sx, sy, sz, t) = (q.sigma_xx, q.sigma_yy.unwrap(), q.sigma_zz, q.sigma_xz);
+    let mises =
+        (0.5 * ((sx - sy).powi(2) + (sy - sz).powi(2) + (sz - sx).powi(2)) + 3.0 * t * t).sqrt();
+    assert!((q.von_mises.unwrap() - mises).abs() < 1e-6);
+}
