@@ -166,12 +166,7 @@ pub fn slip_increments(
         if inside.is_empty() {
             continue;
         }
-        let mut pts: Vec<f64> = breaks
-            .iter()
-            .copied()
-            .filter(|x| *x > from && *x < to)
-            .collect();
-        pts.extend([from, to]);
+        let mut pts = zone_ends_and_breaks(&breaks, from, to);
         let singular = pts.clone();
         pts.extend(inside.iter().map(|&i| xs[i]));
         let is_singular = |x: f64| singular.iter().any(|s| s.to_bits() == x.to_bits());
@@ -248,12 +243,7 @@ fn step_dissipation_with(
     // q̄ and Δε on the graded nodes of each slip zone, split at the traction's breakpoints,
     // with the running integral of q̄ for the inner integral.
     let table = |from: f64, to: f64| {
-        let mut pts: Vec<f64> = breaks
-            .iter()
-            .copied()
-            .filter(|x| *x > from && *x < to)
-            .collect();
-        pts.extend([from, to]);
+        let pts = zone_ends_and_breaks(&breaks, from, to);
         let mut changes = Vec::new();
         let table = crate::contact::graded_cumulative(pts, nodes, smooth, &mut |xs, out| {
             mean_and_change(xs, out, &mut changes)
@@ -276,6 +266,18 @@ fn step_dissipation_with(
         .map(|(&(_, w, _, before), d)| w * d * before)
         .sum();
     -right + left
+}
+
+/// The ends of a slip zone `[from, to]` and the traction's breakpoints strictly inside it: the
+/// pieces of its graded rule (the breakpoints first, then `from` and `to`).
+fn zone_ends_and_breaks(breaks: &[f64], from: f64, to: f64) -> Vec<f64> {
+    let mut pts: Vec<f64> = breaks
+        .iter()
+        .copied()
+        .filter(|x| *x > from && *x < to)
+        .collect();
+    pts.extend([from, to]);
+    pts
 }
 
 #[cfg(test)]
