@@ -71,6 +71,17 @@ impl Cycle {
         0.5 * s.abs()
     }
 
+    /// The largest deviation of a profile's δslip from [`Self::slip_amplitude`] over its grid,
+    /// relative to the closed form's value at the contact end.
+    fn slip_error(&self, profile: &fretsim::fatigue::FatigueProfile) -> f64 {
+        let edge = self.slip_amplitude(self.a * (1.0 - 1e-12));
+        profile
+            .points
+            .iter()
+            .map(|p| (p.slip_amplitude - self.slip_amplitude(p.x)).abs() / edge)
+            .fold(0.0, f64::max)
+    }
+
     /// McEwen's surface σxx0 at the extreme ±Q* (`sign` = ±1).
     fn sigma(&self, x: f64, sign: f64) -> f64 {
         let (a, c) = (self.a, self.c);
@@ -89,11 +100,7 @@ fn mindlin_deresiewicz_local_slip_amplitude() {
     let edge = cycle.slip_amplitude(cycle.a * (1.0 - 1e-12));
     // The y11 of plane strain at ν = 0.5: (1 − ν)/μ.
     assert!((cycle.y11.abs() - 0.5 / 27.3e9).abs() < 1e-12 * cycle.y11.abs());
-    let worst = profile
-        .points
-        .iter()
-        .map(|p| (p.slip_amplitude - cycle.slip_amplitude(p.x)).abs() / edge)
-        .fold(0.0, f64::max);
+    let worst = cycle.slip_error(profile);
     let top = profile.extreme(|p| p.slip_amplitude);
     let grid_edge = profile
         .points
@@ -202,11 +209,7 @@ fn mindlin_deresiewicz_local_slip_amplitude_by_the_general_solver() {
     let cycle = cycle_of(&text);
     let profile = cycle.solution.fatigue.as_ref().expect("a complete cycle");
     let edge = cycle.slip_amplitude(cycle.a * (1.0 - 1e-12));
-    let worst = profile
-        .points
-        .iter()
-        .map(|p| (p.slip_amplitude - cycle.slip_amplitude(p.x)).abs() / edge)
-        .fold(0.0, f64::max);
+    let worst = cycle.slip_error(profile);
     let top = profile.extreme(|p| p.slip_amplitude);
     println!(
         "general solver: δslip within {worst:.2e} of the edge value; largest {:.6e} m at x/a = {}",
