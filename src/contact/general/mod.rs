@@ -79,7 +79,8 @@
 //! which is A = 0, the largest of those sets, as the spectral solver assumes.
 //!
 //! # Tangential subproblem (p and g fixed)
-//! With `U⁰` the element integrals of the previous step's `ux` (the slip reference) and
+//! With `U⁰` the element integrals of the previous step's `ux` (the slip reference; for an
+//! element that enters the contact in the step, its `ux` at entry, module `entry`) and
 //! `c = Ux(p, g) − U⁰`, the tractions minimise the incremental complementary energy
 //!
 //! ```text
@@ -150,7 +151,10 @@
 //! Contact and stick-zone ends lie within one element (a stick run ends at an element edge;
 //! an element that a stick end crosses slips). The pressure converges at second order in the
 //! element size away from the contact ends and at order ½ in the end element, where
-//! `p ~ √(a − x)`. Path-dependent results (the stick zone of incremental normal loading)
+//! `p ~ √(a − x)`. The elements that enter the contact in a step slip from their entry
+//! (module `entry`), so proportional loading of an uncoupled contact sticks everywhere at
+//! any step size; an element that a growing stick zone takes over in a step is still stuck from the
+//! step's start, so path-dependent results (Spence's stick zone of incremental normal loading)
 //! converge at first order in the load step.
 //!
 //! # State
@@ -162,6 +166,7 @@ pub mod influence;
 pub mod mesh;
 
 mod dense;
+mod entry;
 mod handover;
 mod normal;
 mod recall;
@@ -179,6 +184,7 @@ use serde::{Deserialize, Serialize};
 use super::{ContactModel, Coupling, Electrode};
 use crate::error::SolveFailure;
 use dense::Workspace;
+use entry::Entry;
 use influence::Influence;
 pub use mesh::{Focus, Mesh};
 pub use recall::Recall;
@@ -295,6 +301,9 @@ pub struct StepReport {
     /// Whether the normal active set returned to an earlier set (the contact end then sits
     /// where the last admissible set put it).
     pub normal_cycled: bool,
+    /// Solves of the last tangential programme for the slip reference of the elements that
+    /// entered the contact (1 where none did).
+    pub entry_passes: usize,
 }
 
 /// How the electric problem is posed.
@@ -564,6 +573,7 @@ impl Solver {
             tangential_iterations: 0,
             residual: 0.0,
             normal_cycled: false,
+            entry_passes: 0,
         };
         let mut work = Workspace::default();
         for outer in 0..self.options.max_outer {
@@ -614,6 +624,7 @@ impl Solver {
                 tangential_iterations: tangential.iterations,
                 residual: change,
                 normal_cycled: report.normal_cycled || normal.cycled,
+                entry_passes: tangential.entry_passes,
             };
             q = q_new;
             p_old.clone_from(&normal.pressure);
@@ -633,6 +644,10 @@ impl Solver {
     }
 }
 
+/// The most solves of the tangential programme for the slip reference of the elements that
+/// enter the contact in a step (`entry`).
+const ENTRY_PASSES: usize = 40;
+
 /// The tangential subproblem's result on every element.
 struct Tangential {
     slip: Vec<f64>,
@@ -641,6 +656,8 @@ struct Tangential {
     shift: f64,
     tolerance: f64,
     iterations: usize,
+    /// Solves of the programme for the entering elements' reference (1 without entry).
+    entry_passes: usize,
 }
 
 impl Solver {
@@ -693,6 +710,7 @@ impl Solver {
             shift: 0.0,
             tolerance: 0.0,
             iterations: 0,
+            entry_passes: 0,
         };
         if c.friction == 0.0 {
             if let Some(total) = total.filter(|&t| t != 0.0) {
@@ -712,19 +730,34 @@ impl Solver {
             }),
         };
         let w: Vec<f64> = act.iter().map(|&i| self.mesh.width(i)).collect();
-        let lin: Vec<f64> = act
-            .iter()
-            .zip(&w)
-            .map(|(&i, w)| fixed[i] - (previous.displacement[i] + shift) * w)
-            .collect();
+        let enters = (0..n).any(|i| normal.contact[i] && previous.codes[i] == ElementState::Exterior);
+        let entry = if enters {
+            let input = NormalInput {
+                mesh: &self.mesh,
+                influence: &self.influence,
+                coefficients: &self.coefficients,
+                shear: start,
+                normal_load: previous.loads.normal,
+                electric: self.electric_control(previous.loads),
+                grow: false,
+            };
+            let now = (&normal.pressure[..], &normal.charge[..], normal.approach);
+            let gaps = (self.gaps(previous), normal::gaps(&input, now, &normal.contact));
+            Entry::new(&self.mesh, previous, (&gaps.0, &gaps.1), &normal.contact)
+        } else {
+            Entry::default()
+        };
+        let mut reference = previous.displacement.clone();
+        // `ux_B(t1) − Δδx` of each ring's B, from where it was.
+        let mut anchors: Vec<f64> = entry.outer().iter().map(|&b| previous.displacement[b]).collect();
         let bound: Vec<f64> = act
             .iter()
             .map(|&i| c.friction * normal.pressure[i])
             .collect();
-        let begin: Vec<f64> = act.iter().map(|&i| start[i]).collect();
+        let mut begin: Vec<f64> = act.iter().map(|&i| start[i]).collect();
         // The working set of the start: elements at the friction limit of the start traction
         // and the previous pressure keep their bound.
-        let begin_status: Vec<Bound> = act
+        let mut begin_status: Vec<Bound> = act
             .iter()
             .map(|&i| {
                 let u = c.friction * start_pressure[i];
@@ -737,19 +770,80 @@ impl Solver {
                 }
             })
             .collect();
-        let programme = Programme {
-            k: &k,
-            c: &lin,
-            w: &w,
-            bound: &bound,
-            total,
-            elements: &act,
-            kernel: dense::Kernel {
-                log: &self.influence.log,
-                scale: -c.y11 / PI,
-            },
-        };
-        let m = tangential::minimise(&programme, &begin, &begin_status, work)?;
+        // The slip reference of the elements entering the contact (`entry`), by a fixed-point
+        // iteration on the displacement of the free elements next to the new contact ends.
+        let mut m;
+        let mut passes = 0;
+        let mut secant: Option<(Vec<f64>, Vec<f64>)> = None;
+        loop {
+            entry.apply(previous, &anchors, &mut reference);
+            let lin: Vec<f64> = act
+                .iter()
+                .zip(&w)
+                .map(|(&i, w)| fixed[i] - (reference[i] + shift) * w)
+                .collect();
+            let programme = Programme {
+                k: &k,
+                c: &lin,
+                w: &w,
+                bound: &bound,
+                total,
+                elements: &act,
+                kernel: dense::Kernel {
+                    log: &self.influence.log,
+                    scale: -c.y11 / PI,
+                },
+            };
+            m = tangential::minimise(&programme, &begin, &begin_status, work)?;
+            passes += 1;
+            if entry.is_empty() {
+                break;
+            }
+            let moved: Vec<f64> = entry
+                .outer()
+                .iter()
+                .map(|&b| {
+                    let lq: f64 = act
+                        .iter()
+                        .zip(&m.q)
+                        .map(|(&j, q)| self.influence.log[(b, j)] * q)
+                        .sum();
+                    (fixed[b] - (c.y11 / PI) * lq) / self.mesh.width(b) - m.shift - shift
+                })
+                .collect();
+            // Secant steps on g(a) = F(a) − a per anchor (F is affine while the working set
+            // stays: one secant step then solves a ring alone); a plain step first.
+            let residual: Vec<f64> = moved.iter().zip(&anchors).map(|(f, a)| f - a).collect();
+            let change = residual.iter().fold(0.0_f64, |m, r| m.max(r.abs()));
+            let next: Vec<f64> = (0..anchors.len())
+                .map(|r| match &secant {
+                    Some((a_old, g_old)) => {
+                        let (a, g): (&Vec<f64>, &Vec<f64>) = (a_old, g_old);
+                        let slope = (residual[r] - g[r]) / (anchors[r] - a[r]);
+                        if slope.is_finite() && slope < -1e-3 {
+                            anchors[r] - residual[r] / slope
+                        } else {
+                            moved[r]
+                        }
+                    }
+                    None => moved[r],
+                })
+                .collect();
+            secant = Some((anchors.clone(), residual));
+            anchors = next;
+            if change <= m.slip_tolerance {
+                break;
+            }
+            if passes == ENTRY_PASSES {
+                return Err(SolveFailure::NoConvergence {
+                    what: "slip reference of the entering elements",
+                    iterations: passes,
+                    residual: change,
+                });
+            }
+            begin.clone_from(&m.q);
+            begin_status.clone_from(&m.status);
+        }
         work.stiffness = Some((act.clone(), k));
         for (r, &i) in act.iter().enumerate() {
             q[i] = m.q[r];
@@ -759,6 +853,7 @@ impl Solver {
         out.shift = m.shift + shift;
         out.tolerance = m.slip_tolerance;
         out.iterations = m.iterations;
+        out.entry_passes = passes;
         Ok((q, out))
     }
 

@@ -535,8 +535,8 @@ fn coupled_reversal_forms_old_direction_layers_at_the_ends() {
         }
         old.push(s.length_of(SlipNegative) / a);
     }
-    // Measured (in a): 2.2e−3, 2.4e−4, 7.4e−4, 8.4e−4, 0. The middle steps hold one-element
-    // layers at the advancing end, where the elements entering the contact slip outward.
+    // Measured (in a): 2.0e−3, 2.4e−4, 1.2e−3, 1.3e−3, 0. The middle steps hold layers of
+    // about 1e−3 a at the advancing end, where the elements entering the contact slip outward.
     eprintln!("old-direction slip lengths / a: {old:?}");
     assert!(old[4] < 0.1 * old[0], "{old:?}");
 }
@@ -636,12 +636,13 @@ fn proportional_loading(ratio: f64) -> (usize, f64) {
 /// uncoupled contact (ν = 0.5) and Q = λP with λ < η the exact answer is no slip at all and
 /// q = λp (Mindlin's incremental argument: the tangential displacement of q = λp is λ times
 /// the normal displacement of p, which in the contact changes by a rigid approach only, so
-/// each point sticks from the moment it enters the contact). In finite steps a point that
-/// enters the contact during a step carries λ times the gap it closed as a tangential
-/// mismatch, so a few elements at the advancing ends slip; that error must vanish as the
-/// steps shrink. Measured (η = 0.3, λ = 0.15, end elements 1e−3 a, the width growing by 4,
-/// 2, 1 and 0.5 % a step from 0.1 a): at most 18, 12, 8 and 4 elements slip at a step, and
-/// ‖q − λp‖₁/Q = 4.6e−2, 2.3e−2, 1.5e−2, 1.0e−2 at the end (order about 0.7 in the step).
+/// each point sticks from the moment it enters the contact). The element equations keep the
+/// argument exactly when an element that enters the contact in a step sticks from its entry
+/// (`entry`: the free surface moves by λ(y11/y22) times the closing of its gap), so the answer
+/// holds at every step size, to round-off. Measured (η = 0.3, λ = 0.15, end elements 1e−3 a,
+/// the width growing by 4, 2, 1 and 0.5 % a step from 0.1 a): no element slips at any step,
+/// ‖q − λp‖₁/Q = 4.7e−13, 6.4e−13, 9.6e−13, 1.4e−12 at the end (with the step-start reference
+/// of the entering elements: 18, 12, 8 and 4 elements slipped, 4.6e−2 … 1.0e−2).
 #[test]
 fn proportional_loading_sticks_everywhere_with_q_equal_lambda_p() {
     let runs: Vec<(usize, f64)> = [1.04, 1.02, 1.01, 1.005]
@@ -649,11 +650,9 @@ fn proportional_loading_sticks_everywhere_with_q_equal_lambda_p() {
         .map(proportional_loading)
         .collect();
     eprintln!("proportional loading (most slipping elements, ‖q − λp‖₁/Q): {runs:?}");
-    for w in runs.windows(2) {
-        assert!(w[1].0 < w[0].0 && w[1].1 < w[0].1 / 1.3, "{runs:?}");
+    for &(most, l1) in &runs {
+        assert!(most == 0 && l1 < 1e-11, "{runs:?}");
     }
-    let finest = runs[3];
-    assert!(finest.0 <= 4 && finest.1 < 1.1e-2, "{runs:?}");
 }
 
 /// A normal load raised at constant Q on an uncoupled contact (ν = 0.5): the increment of P
