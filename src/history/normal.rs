@@ -336,10 +336,12 @@ mod tests {
             spectral.strain_slope,
             loading.steps
         );
-        // Measured: Δa = −7.0e−5 a (end elements 5e−4 a), Δ(b/a) = −1.1e−3 (elements of
-        // 1e−3 a at b; first order in the step: 1 % steps), ΔC/C = −4.3e−3. One central stick
-        // zone; the slip zones with friction inward (q = −ηp at the right), and a layer of one
-        // element at each end slipping the other way (the end element, where p ~ √(a − x)).
+        // Measured: Δa = 2.5e−4 a (end elements 5e−4 a), Δ(b/a) = −5.0e−4 (elements of
+        // 1e−3 a at b; first order in the step: 1 % steps), ΔC/C = −3.3e−3. One central
+        // stick zone between the slip zones with friction inward (q = −ηp at the right), as
+        // Spence's. (With the slip of the entering elements counted from the step's start:
+        // −7.0e−5 a, −1.1e−3, −4.3e−3, and a layer of one element at each end slipping the
+        // other way.)
         let end = run.state.mesh.width_at(a);
         assert!((rec.half_width - a).abs() <= end);
         assert!((b - spectral.stick_half_width).abs() <= 2e-3 * a);
