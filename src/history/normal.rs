@@ -432,4 +432,22 @@ mod tests {
         assert_eq!(records[0].displacement.to_bits(), 0f64.to_bits());
         assert!(records[20].displacement < records[10].displacement);
     }
+
+    /// PZT-4 at Γ = 2e−7 C/m and η = 0.05, the smallest friction of the failure map: the
+    /// general solver loads the contact by steps. Its tangential programme for the reference
+    /// of the entering elements does not settle from the previous pass's solution at one step
+    /// and is solved again from the step's start (`contact::general`, module `entry`); the
+    /// state found has three stick zones and four slip zones.
+    #[test]
+    fn at_the_smallest_friction_of_the_failure_map_the_general_loading_completes() {
+        let sc = default_scenario_with(0.05, 2e-7);
+        let disc = Discretisation::new(64);
+        let normal =
+            NormalEnd::solve(&sc.model, &disc, 2000.0, SolverChoice::Auto, INNER_SIZE).unwrap();
+        let NormalEnd::General(run, _) = &normal else {
+            panic!("the spectral solver has no state here")
+        };
+        let (p, _, g) = run.state.resultants();
+        assert!((p / 2000.0 - 1.0).abs() < 1e-12 && (g / 2e-7 - 1.0).abs() < 1e-12);
+    }
 }

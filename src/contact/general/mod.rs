@@ -773,6 +773,8 @@ impl Solver {
         // The slip reference of the elements entering the contact (`entry`), by a fixed-point
         // iteration on the displacement of the free elements next to the new contact ends.
         let mut m;
+        let mut last: Option<tangential::Minimiser> = None;
+        let first = (begin.clone(), begin_status.clone());
         let mut passes = 0;
         let mut secant: Option<(Vec<f64>, Vec<f64>)> = None;
         loop {
@@ -794,7 +796,24 @@ impl Solver {
                     scale: -c.y11 / PI,
                 },
             };
-            m = tangential::minimise(&programme, &begin, &begin_status, work)?;
+            // A later pass starts from the last one's solution; where its programme fails
+            // from there, from the step's start; where that fails too, the step keeps the last
+            // pass's solution, whose reference is that of the previous pass (at the first pass,
+            // the step-start one).
+            let solved = tangential::minimise(&programme, &begin, &begin_status, work).or_else(
+                |e| match &last {
+                    Some(_) => tangential::minimise(&programme, &first.0, &first.1, work),
+                    None => Err(e),
+                },
+            );
+            m = match (solved, last.take()) {
+                (Ok(m), _) => m,
+                (Err(_), Some(kept)) => {
+                    m = kept;
+                    break;
+                }
+                (Err(e), None) => return Err(e),
+            };
             passes += 1;
             if entry.is_empty() {
                 break;
@@ -843,6 +862,7 @@ impl Solver {
             }
             begin.clone_from(&m.q);
             begin_status.clone_from(&m.status);
+            last = Some(m);
         }
         work.stiffness = Some((act.clone(), k));
         for (r, &i) in act.iter().enumerate() {
