@@ -34,7 +34,10 @@
 //! reference.
 //!
 //! `w_B(t1)` depends on the new tractions, so the reference is found by a fixed-point
-//! iteration (secant steps) on the solution of the tangential programme.
+//! iteration (secant steps) on the solution of the tangential programme. A pass starts from
+//! the previous pass's solution; where its programme does not settle from there it is solved
+//! from the step's start, and where that fails too the step keeps the previous pass's
+//! solution (at worst that of the step-start reference).
 
 use super::mesh::Mesh;
 use super::{ElementState, GeneralState};
