@@ -153,9 +153,9 @@
 //! element size away from the contact ends and at order ½ in the end element, where
 //! `p ~ √(a − x)`. The elements that enter the contact in a step slip from their entry
 //! (module `entry`), so proportional loading of an uncoupled contact sticks everywhere at
-//! any step size; an element that a growing stick zone takes over in a step is still stuck from the
-//! step's start, so path-dependent results (Spence's stick zone of incremental normal loading)
-//! converge at first order in the load step.
+//! any step size; an element that a growing stick zone takes over in a step is still stuck
+//! from the step's start, so path-dependent results (Spence's stick zone of incremental
+//! normal loading) converge at first order in the load step.
 //!
 //! # State
 //! [`GeneralState`] is plain data: the mesh, p, q, g, ux and the slip per element, the element
@@ -302,7 +302,7 @@ pub struct StepReport {
     /// where the last admissible set put it).
     pub normal_cycled: bool,
     /// Solves of the last tangential programme for the slip reference of the elements that
-    /// entered the contact (1 where none did).
+    /// entered the contact (1 where none did, 0 on a frictionless contact).
     pub entry_passes: usize,
 }
 
