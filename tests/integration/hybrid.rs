@@ -235,3 +235,48 @@ fn a_lost_take_back_postpones_the_next_try() {
         "taken back again"
     );
 }
+
+/// At the paper's baseline Γ = 6e−7 C/m exceeds Γ1 = kP (5.0e−7 C/m), and the conducting-punch
+/// model's states overlap the punch just outside the contact (Spence's state, handed over:
+/// gaps of −1.3e−11 to −2.6e−11 m over the three elements beyond each end, a²/2R = 1.5e−8 m).
+/// The general solver takes those elements into its contact in its first step. They touch
+/// the punch at the step's start already, so they enter with the step-start slip reference
+/// (`contact::general::entry`, φ = 0); given the motion of the free element beyond them over
+/// the whole step instead (φ = 1), they slipped the old way: a third slip zone at the
+/// advancing end at every step, which made each phase start a handover and kept the random
+/// variable-amplitude history of the benches under the general solver at every step. The
+/// first two loading steps of the baseline, 0.05 ηP each: the general solver finds one stick
+/// zone between two slip zones of one sign, as the spectral solver does, and under `auto` no
+/// step is handed over.
+#[test]
+fn above_gamma1_the_elements_that_overlap_the_punch_enter_from_the_step_start() {
+    let text = |solver: &str| {
+        format!(
+            r#"{{"name": "baseline_first_loading", "material": {{"kind": "preset", "name": "pzt4"}},
+ "punch": {{"radius": 0.06, "electrode": {{"kind": "conducting", "charge": 6e-07}}}},
+ "friction": 0.3, "normal_load": 2000.0,
+ "numerics": {{"solver": "{solver}"}},
+ "tangential_history": {{"points": [[0, 0], [1, 0.1]], "steps_per_segment": 2}}}}"#
+        )
+    };
+    let run = |solver: &str| fretsim::solve(&scenario(&text(solver)), &mut NoObserver).unwrap();
+    let general = run("general");
+    assert!(general.failure.is_none());
+    for r in &general.records[1..] {
+        assert_eq!(r.solver, SolverKind::General);
+        assert_eq!(
+            (r.zones.stick, r.zones.slip, r.zones.sign_changes),
+            (1, 2, 0),
+            "step {}",
+            r.step
+        );
+    }
+    let auto = run("auto");
+    assert!(auto.failure.is_none());
+    assert_eq!(auto.summary.solver.handover_count, 0);
+    assert!(
+        auto.records
+            .iter()
+            .all(|r| r.solver == SolverKind::Spectral)
+    );
+}

@@ -16,10 +16,17 @@
 //! the first element outside the new contact beyond it (a free point next to the new end):
 //!
 //! ```text
-//! w_ref,i = w_i(t0) + φ_i (w_B(t1) − w_B(t0)),   φ_i = gap_i(t0) / gap_B(t0)
+//! w_ref,i = w_i(t0) + φ_i (w_B(t1) − w_B(t0)),   φ_i = gap_i(t0) / (gap_B(t0) − gap_B(t1))
 //! ```
 //!
-//! with the element mean gaps of the previous state. This is exact in the two cases where the
+//! clamped to [0, 1], with the element mean gaps of the previous state and of the new one
+//! (φ_i = 1 where B's gap does not close). An element whose gap at `t0` is not positive
+//! touches the punch at the step's start already and enters then (φ_i = 0). That happens
+//! above Γ1 = kP, where the conducting-punch model has no state with both p ≥ 0 and a
+//! non-negative gap: Spence's state and the normal subproblem's (the last set with p ≥ 0,
+//! module docs of [`super`]) overlap the punch just outside the contact ends (the paper's
+//! baseline: −1e−11 to −3e−11 m over about three elements of 5e−4 a, against a²/2R =
+//! 1.5e−8 m), and the contact of a later step takes such elements in. This is exact in the two cases where the
 //! answer is known: on an uncoupled contact under `Q = λP` the free surface moves by
 //! `−λ(y11/y22)` times the closing of its gap (q = λp gives `ux = λ(y11/y22)uz` up to a
 //! constant), so an element that closes `gap_i(t0)` by entry has moved by `φ_i` of what B
@@ -73,7 +80,13 @@ impl Entry {
             members: members
                 .map(|k| {
                     let closed = gaps[b] - now[b];
-                    let phi = if closed > 0.0 { gaps[k] / closed } else { 1.0 };
+                    let phi = if gaps[k] <= 0.0 {
+                        0.0
+                    } else if closed > 0.0 {
+                        gaps[k] / closed
+                    } else {
+                        1.0
+                    };
                     (k, phi.clamp(0.0, 1.0))
                 })
                 .collect(),
