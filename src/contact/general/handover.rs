@@ -198,12 +198,26 @@ impl Solver {
             k if k > values.len() => 0.0,
             k => values[k - 1],
         };
+        // ln|(x_{j+1} − x)/(x_j − x)| of each element that carries a traction or charge, shared
+        // by the three Cauchy integrals.
+        let logs: Vec<f64> = (0..edges.len() - 1)
+            .map(|j| {
+                let carries = [&state.pressure, &state.shear, &state.charge]
+                    .iter()
+                    .any(|values| values.get(j).is_some_and(|&v| v != 0.0));
+                if carries {
+                    ((edges[j + 1] - x) / (edges[j] - x)).abs().ln()
+                } else {
+                    0.0
+                }
+            })
+            .collect();
         let cauchy = |values: &[f64]| {
             values
                 .iter()
-                .enumerate()
-                .filter(|(_, v)| **v != 0.0)
-                .map(|(j, v)| v * ((edges[j + 1] - x) / (edges[j] - x)).abs().ln())
+                .zip(&logs)
+                .filter(|(v, _)| **v != 0.0)
+                .map(|(v, l)| v * l)
                 .sum::<f64>()
                 / PI
         };
