@@ -362,9 +362,8 @@ fn a_coupled_contact_keeps_slipping_under_in_phase_loads_that_shake_the_uncouple
 /// area), of P and of the electric source add up to the frictional dissipation. The
 /// electrode's free charge is −Γ (`g = −Dz(x, 0⁺)`), so the source does `−φ̄0 ΔΓ`; with the
 /// other sign the balance is off by a third of the dissipation. Measured: the third cycle
-/// balances to 1.6e−3 of its dissipation at 10 steps a segment, 1.1e−3 at 40 and 8.2e−4 at 80
-/// (the trapezoidal works; with the slip of the elements entering the contact counted from
-/// the step's start: −2.7e−4, 1.1e−3 and 8.6e−4, the first a cancellation).
+/// balances to −1.3e−4 of its dissipation at 10 steps a segment, 1.2e−3 at 40 and 8.9e−4 at
+/// 80 (the trapezoidal works; the first a cancellation, the bound is set by the other two).
 #[test]
 fn with_a_varying_potential_the_works_of_a_repeating_cycle_add_up_to_the_dissipation() {
     let json = r#"{
