@@ -20,25 +20,29 @@
 //! ```
 //!
 //! clamped to [0, 1], with the element mean gaps of the previous state and of the new one
-//! (φ_i = 1 where B's gap does not close). An element whose gap at `t0` is not positive
-//! touches the punch at the step's start already and enters then (φ_i = 0). That happens
-//! above Γ1 = kP, where the conducting-punch model has no state with both p ≥ 0 and a
-//! non-negative gap: Spence's state and the normal subproblem's (the last set with p ≥ 0,
-//! module docs of [`super`]) overlap the punch just outside the contact ends (the paper's
-//! baseline: −1e−11 to −3e−11 m over about three elements of 5e−4 a, against a²/2R =
-//! 1.5e−8 m), and the contact of a later step takes such elements in. This is exact in the two cases where the
-//! answer is known: on an uncoupled contact under `Q = λP` the free surface moves by
+//! (φ_i = 1 where B's gap does not close). This is exact in the two cases where the answer
+//! is known: on an uncoupled contact under `Q = λP` the free surface moves by
 //! `−λ(y11/y22)` times the closing of its gap (q = λp gives `ux = λ(y11/y22)uz` up to a
 //! constant), so an element that closes `gap_i(t0)` by entry has moved by `φ_i` of what B
 //! moved in closing (nearly all of) `gap_B(t0)`; and where the free surface does not move
 //! (a normal load raised at constant Q on an uncoupled contact) the reference is the
 //! step-start one. Elsewhere `φ_i` ranges from 0 at the old end to 1 at the new, and the
 //! reference errs by the motion's departure from that proportion, a fraction of one step's
-//! motion of the end. Where nothing was in contact before the step (the surface undeformed),
-//! the ring is split at the profile's lowest point x = 0, where the punch touched first, and
-//! each side takes its own B. A ring
-//! between two elements of the previous contact (a gap closing inside) keeps the step-start
-//! reference.
+//! motion of the end.
+//!
+//! An element whose gap at `t0` is not positive touches the punch at the step's start
+//! already and enters then (φ_i = 0). That happens above Γ1 = kP, where the conducting-punch
+//! model has no state with both p ≥ 0 and a non-negative gap: Spence's state and the normal
+//! subproblem's (the last set with p ≥ 0, module docs of [`super`]) overlap the punch just
+//! outside the contact ends (the paper's baseline: −1e−11 to −3e−11 m over about three
+//! elements of 5e−4 a, against a²/2R = 1.5e−8 m), and the contact of a later step takes such
+//! elements in. Given B's motion over the whole step (φ_i = 1: B's gap opens there), they
+//! would slip the old way at the advancing end in every step.
+//!
+//! Where nothing was in contact before the step (the surface undeformed), the ring is split
+//! at the profile's lowest point x = 0, where the punch touched first, and each side takes
+//! its own B. A ring between two elements of the previous contact (a gap closing inside)
+//! keeps the step-start reference.
 //!
 //! `w_B(t1)` depends on the new tractions, so the reference is found by a fixed-point
 //! iteration (secant steps) on the solution of the tangential programme. A pass starts from
