@@ -38,7 +38,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::contact::general::ElementState;
+use crate::contact::general::{ElementState, PointLogs};
 use crate::contact::{ContactModel, SurfacePoint};
 use crate::history::{Regime, StateView, StepRecord};
 
@@ -97,11 +97,14 @@ pub const GRID_PIECE_NODES: usize = 16;
 /// spectral solver takes the state back from the general solver (the one step whose states
 /// are of different solvers) counts no slip: its increment is not defined between the two
 /// discretisations. A held step (the general solver carries its state over) counts none.
+/// The fields of an element state are evaluated with the logarithms kept in `logs` where
+/// given ([`PointLogs`]: the same values, faster over the steps of one mesh).
 pub fn step_samples(
     model: &ContactModel,
     grid: &[f64],
     old: Option<StateView<'_>>,
     new: StateView<'_>,
+    logs: Option<&mut PointLogs>,
 ) -> Vec<PointSample> {
     match new {
         StateView::Spectral(state) => {
@@ -128,8 +131,10 @@ pub fn step_samples(
                 Some(StateView::General(_, before)) => before != state,
                 Some(StateView::Spectral(_)) => true,
             };
+            let points = solver.surface_points(model, state, grid, logs);
             grid.iter()
-                .map(|&x| {
+                .zip(&points)
+                .map(|(&x, point)| {
                     let element = match edges.partition_point(|&e| e <= x) {
                         0 => None,
                         k if k > state.codes.len() => None,
@@ -141,8 +146,7 @@ pub fn step_samples(
                         Some(i) if slipping => state.slip[i],
                         _ => 0.0,
                     };
-                    let point = solver.surface_point(model, state, x);
-                    point_sample(model, &point, in_contact, slip)
+                    point_sample(model, point, in_contact, slip)
                 })
                 .collect()
         }

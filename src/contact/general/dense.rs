@@ -164,15 +164,22 @@ impl SubsetCholesky {
     }
 }
 
-/// Factors kept through the outer iterations of one step.
+/// What one step keeps through its outer iterations: factors, L on the contact set, the
+/// previous state's gaps and the tangential slip tolerance.
 #[derive(Debug, Default)]
 pub(super) struct Workspace {
     /// `−L/π` on the contact set.
     pub normal: Option<SubsetCholesky>,
     /// The tangential stiffness on the free set.
     pub tangential: Option<SubsetCholesky>,
-    /// The tangential stiffness K on the contact set (its mesh indices, K).
+    /// L on the contact set where it is gathered (its mesh indices, L).
     pub stiffness: Option<(Vec<usize>, Mat<f64>)>,
+    /// The gaps of the step's previous state, once a step needs them (elements that enter
+    /// the contact).
+    pub previous_gaps: Option<Vec<f64>>,
+    /// The slip below which an element of the tangential programme counts as not slipping
+    /// (m), set by the first programme on the contact set (its mesh indices, the tolerance).
+    pub slip_tolerance: Option<(Vec<usize>, f64)>,
 }
 
 impl Workspace {

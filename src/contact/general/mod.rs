@@ -186,6 +186,7 @@ use crate::error::SolveFailure;
 use dense::Workspace;
 use entry::Entry;
 use influence::Influence;
+pub use handover::PointLogs;
 pub use mesh::{Focus, Mesh};
 pub use recall::Recall;
 use normal::{NormalInput, NormalSolution};
@@ -722,12 +723,23 @@ impl Solver {
             return Ok((q, out));
         }
         let fixed = self.fixed_displacement(&normal.pressure, &normal.charge, bulk_stress);
-        // K on the contact elements, kept while the contact set stays.
-        let k = match work.stiffness.take() {
-            Some((set, k)) if set == act => k,
-            _ => Mat::<f64>::from_fn(act.len(), act.len(), |r, s| {
-                -(c.y11 / PI) * self.influence.log[(act[r], act[s])]
-            }),
+        // L on the contact elements (K = −(y11/π) L): a view of the mesh's matrix where they
+        // are consecutive, as they are unless a ring has entered; else gathered, and kept
+        // while the contact set stays.
+        let consecutive = act.windows(2).all(|w| w[1] == w[0] + 1);
+        let gathered = match work.stiffness.take() {
+            Some((set, l)) if set == act => Some(l),
+            _ if consecutive => None,
+            _ => Some(Mat::<f64>::from_fn(act.len(), act.len(), |r, s| {
+                self.influence.log[(act[r], act[s])]
+            })),
+        };
+        let l = match &gathered {
+            Some(l) => l.as_ref(),
+            None => {
+                let first = act.first().copied().unwrap_or(0);
+                (self.influence.log.as_ref()).submatrix(first, first, act.len(), act.len())
+            }
         };
         let w: Vec<f64> = act.iter().map(|&i| self.mesh.width(i)).collect();
         let enters = (0..n).any(|i| normal.contact[i] && previous.codes[i] == ElementState::Exterior);
@@ -742,8 +754,9 @@ impl Solver {
                 grow: false,
             };
             let now = (&normal.pressure[..], &normal.charge[..], normal.approach);
-            let gaps = (self.gaps(previous), normal::gaps(&input, now, &normal.contact));
-            Entry::new(&self.mesh, previous, (&gaps.0, &gaps.1), &normal.contact)
+            let after = normal::gaps(&input, now, &normal.contact);
+            let before = (work.previous_gaps).get_or_insert_with(|| self.gaps(previous));
+            Entry::new(&self.mesh, previous, (before, &after), &normal.contact)
         } else {
             Entry::default()
         };
@@ -785,7 +798,7 @@ impl Solver {
                 .map(|(&i, w)| fixed[i] - (reference[i] + shift) * w)
                 .collect();
             let programme = Programme {
-                k: &k,
+                l,
                 c: &lin,
                 w: &w,
                 bound: &bound,
@@ -864,7 +877,7 @@ impl Solver {
             begin_status.clone_from(&m.status);
             last = Some(m);
         }
-        work.stiffness = Some((act.clone(), k));
+        work.stiffness = gathered.map(|l| (act.clone(), l));
         for (r, &i) in act.iter().enumerate() {
             q[i] = m.q[r];
             out.slip[i] = m.slip[r];

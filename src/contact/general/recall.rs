@@ -154,7 +154,8 @@ impl Recall {
     }
 }
 
-fn same_bits(a: &[f64], b: &[f64]) -> bool {
+/// Whether `a` and `b` are equal to the bit.
+pub(super) fn same_bits(a: &[f64], b: &[f64]) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 

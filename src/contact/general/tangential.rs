@@ -4,10 +4,9 @@
 //! settle, by the primal active-set method (Nocedal & Wright, *Numerical Optimization*,
 //! Algorithm 16.3).
 
-use faer::Mat;
+use faer::{Accum, ColMut, ColRef, MatRef, Par};
 
 use super::dense::{Kernel, Workspace};
-use super::influence::mat_vec;
 use super::normal::not_definite;
 
 use crate::error::SolveFailure;
@@ -18,8 +17,8 @@ use crate::error::SolveFailure;
 /// is then box-constrained only, and has a minimiser with every element at a bound (gross
 /// slip).
 pub(super) struct Programme<'a> {
-    /// `K` (symmetric positive definite), contact elements only.
-    pub k: &'a Mat<f64>,
+    /// `L` on the contact elements, `K = kernel.scale · L` (symmetric positive definite).
+    pub l: MatRef<'a, f64>,
     /// `c`, the displacement of the fixed loads minus the reference, integrated per element.
     pub c: &'a [f64],
     /// Element widths `w`.
@@ -146,7 +145,9 @@ fn free_step(
     Ok((d, shift))
 }
 
-/// The minimiser, started from the working set `start` (the previous solution's): first by
+/// The minimiser, started from the working set `start` (the previous solution's), to the
+/// slip tolerance 1e−10 of the slip scale of the first programme on the same contact set
+/// solved with `work` (the bounds move little over a step's outer iterations): first by
 /// the primal–dual active-set method (a semismooth Newton method on the complementarity
 /// conditions, which changes many elements at once), then, if that does not settle within a
 /// few iterations or ends infeasible, by the primal active-set method, which terminates.
@@ -156,23 +157,48 @@ pub(super) fn minimise(
     start_status: &[Bound],
     work: &mut Workspace,
 ) -> Result<Minimiser, SolveFailure> {
-    let n = p.c.len();
-    // Slip scale: the largest mean displacement an admissible traction produces.
-    let scale = (0..n)
-        .map(|i| {
-            let col = p.k.col_as_slice(i);
-            col.iter()
-                .zip(p.bound)
-                .map(|(k, u)| k.abs() * u)
-                .sum::<f64>()
-                / p.w[i]
-        })
-        .fold(0.0, f64::max);
-    let tol = 1e-10 * scale;
+    let tol = match &work.slip_tolerance {
+        Some((set, tol)) if set == p.elements => *tol,
+        _ => {
+            let tol = 1e-10 * slip_scale(p);
+            work.slip_tolerance = Some((p.elements.to_vec(), tol));
+            tol
+        }
+    };
     if let Some(m) = primal_dual(p, start_status, tol, work)? {
         return Ok(m);
     }
     primal(p, start, tol, work)
+}
+
+/// The largest mean displacement an admissible traction of `p` produces,
+/// `max_i Σ_j |K_ij| u_j / w_i`.
+fn slip_scale(p: &Programme) -> f64 {
+    (0..p.c.len())
+        .map(|i| {
+            let col = p.l.col(i).try_as_col_major().expect("columns of L are contiguous");
+            p.kernel.scale.abs() * abs_dot(col.as_slice(), p.bound) / p.w[i]
+        })
+        .fold(0.0, f64::max)
+}
+
+/// `Σ |a_i| b_i`, summed in eight independent lanes (the compiler vectorises it; a single
+/// running sum is a chain of dependent additions).
+fn abs_dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut lanes = [0.0; 8];
+    let (a8, b8) = (a.chunks_exact(8), b.chunks_exact(8));
+    let tail: f64 = a8
+        .remainder()
+        .iter()
+        .zip(b8.remainder())
+        .map(|(x, y)| x.abs() * y)
+        .sum();
+    for (x, y) in a8.zip(b8) {
+        for ((lane, x), y) in lanes.iter_mut().zip(x).zip(y) {
+            *lane += x.abs() * y;
+        }
+    }
+    lanes.iter().sum::<f64>() + tail
 }
 
 /// Primal–dual active set (Hintermüller, Ito & Kunisch 2003): fix the bound elements at their
@@ -362,11 +388,15 @@ fn shift_without_free(p: &Programme, grad: &[f64], status: &[Bound]) -> f64 {
 
 /// `∇J = K q + c`.
 fn gradient(p: &Programme, q: &[f64]) -> Vec<f64> {
-    let mut grad = vec![0.0; q.len()];
-    mat_vec(p.k, q, &mut grad);
-    for (g, c) in grad.iter_mut().zip(p.c) {
-        *g += c;
-    }
+    let mut grad = p.c.to_vec();
+    faer::linalg::matmul::matmul(
+        ColMut::from_slice_mut(&mut grad).as_mat_mut(),
+        Accum::Add,
+        p.l,
+        ColRef::from_slice(q).as_mat(),
+        p.kernel.scale,
+        Par::Seq,
+    );
     grad
 }
 
@@ -383,7 +413,6 @@ mod tests {
         let mesh = Mesh::uniform(-1.0, 1.0, 40);
         let inf = Influence::new(&mesh, 10.0);
         let n = mesh.len();
-        let k = Mat::<f64>::from_fn(n, n, |i, j| -inf.log[(i, j)] / std::f64::consts::PI);
         let x = mesh.centres();
         let w = mesh.widths();
         // A linear term that drives opposite slips at the two ends, and Hertzian bounds.
@@ -391,7 +420,7 @@ mod tests {
         let bound: Vec<f64> = x.iter().map(|x| 0.3 * (1.0 - x * x).sqrt()).collect();
         let elements: Vec<usize> = (0..n).collect();
         let p = Programme {
-            k: &k,
+            l: inf.log.as_ref(),
             c: &c,
             w: &w,
             bound: &bound,
