@@ -511,8 +511,41 @@ fn load_paths(c: &mut Criterion) {
     g.finish();
 }
 
+/// A whole run in memory, with its outputs' analyses (cycles, fatigue indicators on the field
+/// grid): the first 40 reversals of `benches/scenarios/random_variable_amplitude_100.json`
+/// (the default contact, random amplitudes 0.1–0.7 ηP, 292 steps) under `auto`, where the
+/// spectral solver takes the steps and the general solver checks each phase's first, and
+/// under `general`, where the general solver takes every step: a history that the general
+/// solver holds costs their ratio (issue 37's flat-cost measurement).
+fn random_history(c: &mut Criterion) {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/benches/scenarios/random_variable_amplitude_100.json"
+    ))
+    .unwrap();
+    let mut raw: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let points = raw["tangential_history"]["points"].as_array_mut().unwrap();
+    points.truncate(41);
+    let mut g = c.benchmark_group("run/random_history_40_reversals");
+    g.sample_size(10);
+    for solver in ["auto", "general"] {
+        raw["numerics"] = serde_json::json!({ "solver": solver });
+        let text = raw.to_string();
+        let sc =
+            fretsim::validate(fretsim::parse(&text, std::path::Path::new("bench.json")).unwrap())
+                .unwrap();
+        g.bench_function(BenchmarkId::from_parameter(solver), |b| {
+            b.iter(|| {
+                black_box(fretsim::io::solve(&sc, &mut fretsim::history::NoObserver).unwrap())
+            })
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    random_history,
     load_paths,
     general_step,
     kernels,
