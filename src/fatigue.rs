@@ -115,12 +115,11 @@ pub fn step_samples(
                 _ => vec![0.0; grid.len()],
             };
             let (c, a) = (state.centre, state.half_width);
+            let points = model.surface_points(state, grid);
             grid.iter()
                 .zip(slips)
-                .map(|(&x, slip)| {
-                    let point = model.surface_point(state, x);
-                    point_sample(model, &point, (x - c).abs() < a, slip)
-                })
+                .zip(&points)
+                .map(|((&x, slip), point)| point_sample(model, point, (x - c).abs() < a, slip))
                 .collect()
         }
         StateView::General(solver, state) => {

@@ -277,7 +277,12 @@ impl ContactState {
 
     /// `H'g(x)` (C/m²).
     pub fn charge_cauchy(&self, x: f64) -> f64 {
-        self.split.ratio * self.pressure_cauchy(x)
+        self.charge_cauchy_with(x, self.pressure_cauchy(x))
+    }
+
+    /// [`Self::charge_cauchy`] given `H'p(x)`.
+    pub fn charge_cauchy_with(&self, x: f64, pressure_cauchy: f64) -> f64 {
+        self.split.ratio * pressure_cauchy
             + self.potential_charge.cauchy(self.tau(x))
             + self.kinks_with(&self.charge_kinks, |u, v| half_ellipse_cauchy(x, u, v))
     }

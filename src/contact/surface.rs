@@ -40,6 +40,31 @@ impl ContactModel {
         self.surface_fields(x, (p, q, g), dux, dphi)
     }
 
+    /// [`Self::surface_point`] at each of `xs` (bit-identical): p, H'p, q and the strain in
+    /// batches ([`ContactState::pressures_and_cauchys_into`], [`ContactState::tractions_with`],
+    /// [`ContactState::strains_with`]), which sum the stick zone's chain for eight points at
+    /// a time.
+    pub fn surface_points(&self, state: &ContactState, xs: &[f64]) -> Vec<SurfacePoint> {
+        let c = &self.compliance;
+        let (y23, y33, w13) = c
+            .electric
+            .map_or((0.0, 0.0, 0.0), |e| (e.y23, e.y33, e.w13));
+        let (mut p, mut h, mut q, mut strain) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        state.pressures_and_cauchys_into(xs, &mut p, &mut h);
+        state.tractions_with(xs, &p, &mut q);
+        state.strains_with(self, xs, (&p, &h), &mut strain);
+        let mut w = Vec::new();
+        state.potential_charges_into(xs, &mut w);
+        (0..xs.len())
+            .map(|k| {
+                let x = xs[k];
+                let g = state.split.ratio * p[k] + w[k];
+                let dphi = w13 * q[k] + y23 * h[k] + y33 * state.charge_cauchy_with(x, h[k]);
+                self.surface_fields(x, (p[k], q[k], g), strain[k], dphi)
+            })
+            .collect()
+    }
+
     /// σxx0 and Dx0 (seed eqs. 64–65) from p, q, g, the surface strain `∂ux/∂x` and the
     /// potential gradient `∂φ/∂x` at x.
     pub fn surface_fields(
@@ -259,6 +284,56 @@ fn log_moment(lo: f64, hi: f64, x: f64, d: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The batch gives [`ContactModel::surface_point`]'s values to the bit at 401 points in and
+    /// beside the contact, over the normal loading's state and the first 30 steps of the
+    /// default history (a loading and a reversal, with the chains of earlier stick zones).
+    #[test]
+    fn surface_points_are_surface_point_at_each_point() {
+        use crate::contact::pressure::Discretisation;
+        use crate::contact::tangential::SlipOptions;
+        use crate::history::{LoadPoint, NoObserver, advance, driver_after_normal_loading};
+        let sc = crate::scenario::default_scenario();
+        let disc = Discretisation::new(64);
+        let mut driver = driver_after_normal_loading(&sc, &disc);
+        let steps = sc.history.as_ref().expect("default history").steps();
+        let bits = |p: &SurfacePoint| {
+            [p.x, p.pressure, p.traction, p.charge, p.sigma_xx, p.d_x].map(f64::to_bits)
+        };
+        for (i, &(_, t, q)) in steps.iter().take(30).enumerate() {
+            if i > 0 {
+                let point = LoadPoint {
+                    step: i,
+                    t,
+                    q,
+                    punch: None,
+                };
+                let options = SlipOptions::default();
+                advance(
+                    &sc.model,
+                    &disc,
+                    &mut driver,
+                    point,
+                    options,
+                    &mut NoObserver,
+                )
+                .unwrap();
+            }
+            let s = &driver.state;
+            let xs: Vec<f64> = (0..401)
+                .map(|k| s.centre + s.half_width * (-1.5 + 3.0 * (k as f64 + 0.3) / 401.0))
+                .collect();
+            let batch = sc.model.surface_points(s, &xs);
+            for (&x, b) in xs.iter().zip(&batch) {
+                assert_eq!(
+                    bits(b),
+                    bits(&sc.model.surface_point(s, x)),
+                    "step {i}, x = {x:e}"
+                );
+            }
+        }
+        assert!(driver.phase >= 2, "the steps reach a reversal");
+    }
 
     #[test]
     fn log_moment_matches_hand_integrals() {
