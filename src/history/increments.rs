@@ -283,9 +283,8 @@ fn zone_ends_and_breaks(breaks: &[f64], from: f64, to: f64) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use crate::contact::pressure::Discretisation;
-    use crate::contact::tangential::SlipOptions;
 
-    use crate::history::{LoadPoint, NoObserver, advance, driver_after_normal_loading};
+    use crate::history::walk_default_history;
 
     use super::*;
 
@@ -298,34 +297,15 @@ mod tests {
     fn the_slip_increments_integrate_to_the_step_dissipation() {
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(64);
-        let mut driver = driver_after_normal_loading(&sc, &disc);
-        let steps = sc.history.as_ref().expect("default history").steps();
         let (mut worst, mut largest) = ([0.0f64; 2], 0.0f64);
-        for (i, &(_, t, q)) in steps.iter().take(20).enumerate() {
-            let old = driver.state.clone();
-            let point = LoadPoint {
-                step: i + 1,
-                t,
-                q,
-                punch: None,
-            };
-            advance(
-                &sc.model,
-                &disc,
-                &mut driver,
-                point,
-                SlipOptions::default(),
-                &mut NoObserver,
-            )
-            .unwrap();
-            let new = &driver.state;
+        walk_default_history(&disc, 20, |old, new| {
             let (lo, hi) = (new.centre - new.half_width, new.centre + new.half_width);
-            let exact = step_dissipation(&sc.model, &old, new);
+            let exact = step_dissipation(&sc.model, old, new);
             largest = largest.max(exact.abs());
             for (k, n) in [2000, 4000].into_iter().enumerate() {
                 let h = (hi - lo) / n as f64;
                 let xs: Vec<f64> = (0..n).map(|j| lo + (j as f64 + 0.5) * h).collect();
-                let slips = slip_increments(&sc.model, &old, new, &xs, 16);
+                let slips = slip_increments(&sc.model, old, new, &xs, 16);
                 let (mut q_new, mut q_old) = (Vec::new(), Vec::new());
                 new.tractions_into(&xs, &mut q_new);
                 old.tractions_into(&xs, &mut q_old);
@@ -334,7 +314,7 @@ mod tests {
                     .sum();
                 worst[k] = worst[k].max((by_points - exact).abs());
             }
-        }
+        });
         let relative = [worst[0] / largest, worst[1] / largest];
         println!(
             "−∫ q̄ Δs by 2,000 and 4,000 points within {:.2e} and {:.2e} of the largest step \
@@ -357,38 +337,19 @@ mod tests {
     fn the_dissipation_rule_gives_the_step_dissipations_to_a_small_error() {
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(128);
-        let mut driver = driver_after_normal_loading(&sc, &disc);
-        let steps = sc.history.as_ref().expect("default history").steps();
         let fine = (4 * crate::contact::slip_zone_rule_nodes(128), None);
         let graded = crate::contact::slip_zone_rule_nodes(128);
         let (mut rule, mut reference, mut few) = (Vec::new(), Vec::new(), Vec::new());
-        for (i, &(_, t, q)) in steps.iter().take(30).enumerate() {
-            let old = driver.state.clone();
-            let point = LoadPoint {
-                step: i + 1,
-                t,
-                q,
-                punch: None,
-            };
-            let options = SlipOptions::default();
-            advance(
-                &sc.model,
-                &disc,
-                &mut driver,
-                point,
-                options,
-                &mut NoObserver,
-            )
-            .unwrap();
-            rule.push(step_dissipation(&sc.model, &old, &driver.state));
-            reference.push(step_dissipation_with(&sc.model, &old, &driver.state, fine));
+        walk_default_history(&disc, 30, |old, new| {
+            rule.push(step_dissipation(&sc.model, old, new));
+            reference.push(step_dissipation_with(&sc.model, old, new, fine));
             few.push(step_dissipation_with(
                 &sc.model,
-                &old,
-                &driver.state,
+                old,
+                new,
                 (graded, Some(4)),
             ));
-        }
+        });
         let largest = reference.iter().fold(0.0f64, |m, d| m.max(d.abs()));
         let worst_of = |rule: &[f64]| {
             rule.iter()

@@ -135,6 +135,40 @@ pub(crate) fn driver_after_normal_loading(
     DriverState::after_normal_loading(&normal)
 }
 
+/// The first `steps` steps of the default scenario's history from the end of its normal
+/// loading on `disc`, each taken by [`advance`] with the default options; `visit` sees each
+/// step's state before and after it (the tests' walk over the first phases).
+#[cfg(test)]
+pub(crate) fn walk_default_history(
+    disc: &Discretisation,
+    steps: usize,
+    mut visit: impl FnMut(&crate::contact::ContactState, &crate::contact::ContactState),
+) {
+    let sc = crate::scenario::default_scenario();
+    let mut driver = driver_after_normal_loading(&sc, disc);
+    let history = sc.history.as_ref().expect("default history").steps();
+    for (i, &(_, t, q)) in history.iter().take(steps).enumerate() {
+        let old = driver.state.clone();
+        let point = LoadPoint {
+            step: i + 1,
+            t,
+            q,
+            punch: None,
+        };
+        let options = crate::contact::tangential::SlipOptions::default();
+        advance(
+            &sc.model,
+            disc,
+            &mut driver,
+            point,
+            options,
+            &mut NoObserver,
+        )
+        .unwrap();
+        visit(&old, &driver.state);
+    }
+}
+
 /// The default scenario (PZT-4, conducting punch, R = 60 mm, P = 2000 N/m, its history) with
 /// friction `eta` and charge `gamma` (C/m).
 #[cfg(test)]

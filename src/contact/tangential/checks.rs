@@ -166,7 +166,6 @@ fn slip_work_densities(
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::advance_driver;
     use super::*;
     use crate::contact::pressure::Discretisation;
 
@@ -176,33 +175,21 @@ mod tests {
     /// zone, relative to the step's largest), with the states the driver reaches.
     #[test]
     fn the_slip_check_rule_reads_the_sign_to_a_small_error() {
-        use crate::history::LoadPoint;
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(sc.collocation_points);
-        let mut driver = crate::history::driver_after_normal_loading(&sc, &disc);
-        let steps = sc.history.as_ref().expect("default history").steps();
         let nodes = crate::contact::slip_check_rule_nodes(disc.nodes());
         let mut worst: f64 = 0.0;
-        for (i, &(_, t, q)) in steps.iter().take(30).enumerate() {
-            let old = driver.state.clone();
-            let point = LoadPoint {
-                step: i + 1,
-                t,
-                q,
-                punch: None,
-            };
-            advance_driver(&sc, &disc, &mut driver, point);
-            let new = &driver.state;
+        crate::history::walk_default_history(&disc, 30, |old, new| {
             if new.traction.stick.is_none() || old.traction.stick.is_none() {
-                continue;
+                return;
             }
-            let coarse = slip_work_densities(&sc.model, &old, new, nodes);
-            let fine = slip_work_densities(&sc.model, &old, new, 8 * nodes);
+            let coarse = slip_work_densities(&sc.model, old, new, nodes);
+            let fine = slip_work_densities(&sc.model, old, new, 8 * nodes);
             let largest = fine.iter().fold(0.0f64, |m, s| m.max(s.2.abs()));
             for (c, f) in coarse.iter().zip(&fine) {
                 worst = worst.max((c.2 - f.2).abs() / largest);
             }
-        }
+        });
         println!("worst slip check error {worst:.2e}");
         // Measured 2.3e−5 (and 1.2e−4 at worst over the regression batch).
         assert!(worst > 0.0 && worst < 1e-4, "{worst:e}");

@@ -599,26 +599,15 @@ mod tests {
     /// history at M = 128 (at M ≤ 64 the rule is the whole rule).
     #[test]
     fn the_contact_rule_gives_the_displacements_to_a_small_error() {
-        use crate::history::LoadPoint;
         let sc = crate::scenario::default_scenario();
         let disc = Discretisation::new(128);
-        let mut driver = crate::history::driver_after_normal_loading(&sc, &disc);
-        let steps = sc.history.as_ref().expect("default history").steps();
         let fine = 4 * crate::contact::field_rule_nodes(disc.nodes());
         let (mut rule, mut reference) = (Vec::new(), Vec::new());
-        for (i, &(_, t, q)) in steps.iter().take(30).enumerate() {
-            let point = LoadPoint {
-                step: i + 1,
-                t,
-                q,
-                punch: None,
-            };
-            advance_driver(&sc, &disc, &mut driver, point);
-            let s = &driver.state;
+        crate::history::walk_default_history(&disc, 30, |_, s| {
             // The contact centre at normal loading lies in every stick zone of these phases.
             rule.push(s.displacement_and_approach(&sc.model, 0.0));
             reference.push(s.displacement_and_approach_with(&sc.model, 0.0, |_, _| fine));
-        }
+        });
         let range = |f: fn(&(f64, f64)) -> f64| {
             let v: Vec<f64> = reference.iter().map(f).collect();
             v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
