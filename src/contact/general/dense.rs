@@ -173,7 +173,7 @@ pub(super) struct Workspace {
     /// The tangential stiffness on the free set.
     pub tangential: Option<SubsetCholesky>,
     /// L on the contact set where it is gathered (its mesh indices, L).
-    pub stiffness: Option<(Vec<usize>, Mat<f64>)>,
+    pub gathered_log: Option<(Vec<usize>, Mat<f64>)>,
     /// The gaps of the step's previous state, once a step needs them (elements that enter
     /// the contact).
     pub previous_gaps: Option<Vec<f64>>,

@@ -727,7 +727,7 @@ impl Solver {
         // are consecutive, as they are unless a ring has entered; else gathered, and kept
         // while the contact set stays.
         let consecutive = act.windows(2).all(|w| w[1] == w[0] + 1);
-        let gathered = match work.stiffness.take() {
+        let gathered = match work.gathered_log.take() {
             Some((set, l)) if set == act => Some(l),
             _ if consecutive => None,
             _ => Some(Mat::<f64>::from_fn(act.len(), act.len(), |r, s| {
@@ -877,7 +877,7 @@ impl Solver {
             begin_status.clone_from(&m.status);
             last = Some(m);
         }
-        work.stiffness = gathered.map(|l| (act.clone(), l));
+        work.gathered_log = gathered.map(|l| (act.clone(), l));
         for (r, &i) in act.iter().enumerate() {
             q[i] = m.q[r];
             out.slip[i] = m.slip[r];
