@@ -98,7 +98,7 @@ pub const GRID_PIECE_NODES: usize = 16;
 /// are of different solvers) counts no slip: its increment is not defined between the two
 /// discretisations. A held step (the general solver carries its state over) counts none.
 /// The fields of an element state are evaluated with the logarithms kept in `logs` where
-/// given ([`PointLogs`]: the same values, faster over the steps of one mesh).
+/// given ([`PointLogs`]: the same values to round-off, faster over the steps of one mesh).
 pub fn step_samples(
     model: &ContactModel,
     grid: &[f64],

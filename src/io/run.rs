@@ -133,7 +133,7 @@ pub(crate) struct Snapshots<'a> {
     /// Whether the run ended where its cycles had settled (`numerics.stop_when_settled`).
     stopped: std::cell::Cell<bool>,
     /// The logarithms of the fatigue grid on the general solver's last mesh (a speed-up:
-    /// the samples are the same without it).
+    /// the samples agree with those without it to round-off).
     point_logs: PointLogs,
 }
 
