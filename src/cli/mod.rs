@@ -158,15 +158,23 @@ fn run(
             n.zones.stick, n.zones.slip
         ),
     };
-    println!(
-        "{}: a = {:.6e} m, b/a = {:.6}, C = {:.6e} 1/m, p0 = {:.6e} Pa{by} -> {}",
-        sc.name,
-        n.half_width,
-        n.stick_ratio,
-        n.strain_slope,
-        n.peak_pressure,
-        result.out_dir.display()
-    );
+    if sc.normal_load > 0.0 {
+        println!(
+            "{}: a = {:.6e} m, b/a = {:.6}, C = {:.6e} 1/m, p0 = {:.6e} Pa{by} -> {}",
+            sc.name,
+            n.half_width,
+            n.stick_ratio,
+            n.strain_slope,
+            n.peak_pressure,
+            result.out_dir.display()
+        );
+    } else {
+        println!(
+            "{}: from the unloaded punch (normal_load 0), general solver -> {}",
+            sc.name,
+            result.out_dir.display()
+        );
+    }
     for w in &result.solution.summary.warnings {
         eprintln!("fretsim: warning: {w}");
     }

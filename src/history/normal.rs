@@ -84,6 +84,16 @@ impl NormalEnd {
         solver: SolverChoice,
         inner: f64,
     ) -> Result<Self, SolveFailure> {
+        if normal_load == 0.0 {
+            return match solver {
+                SolverChoice::Spectral => Err(SolveFailure::NoAdmissibleState {
+                    reason: "the spectral solver's history starts from its normal loading; a \
+                             history from the unloaded punch (P = 0) needs the general solver"
+                        .into(),
+                }),
+                _ => Ok(Self::unloaded(model, inner)),
+            };
+        }
         let failure = if !model.profile.is_cylinder() {
             SolveFailure::NoAdmissibleState {
                 reason: "the spectral solver takes a cylindrical punch only".into(),
@@ -105,6 +115,25 @@ impl NormalEnd {
         })?;
         loading.spectral_failure = failure.to_string();
         Ok(Self::General(Box::new(run), loading))
+    }
+
+    /// The unloaded punch touching the undeformed surface, the start of a history from P = 0
+    /// (`normal_load` 0): the general solver's state without contact
+    /// ([`Solver::separated`]); the history's first step that raises P presses the punch,
+    /// on a mesh made for the frictionless contact of its loads
+    /// ([`super::general::mesh_for_loads`]), and the general solver holds every step.
+    fn unloaded(model: &ContactModel, inner: f64) -> Self {
+        let solver = Solver::new(model, Mesh::uniform(-1.0, 1.0, 2), Options::default());
+        let state = solver.separated(loads_of(model, 0.0, 0.0), 0.0);
+        let loading = Loading {
+            steps: 0,
+            iterations: 0,
+            spectral_failure: "the history starts from the unloaded punch (normal_load 0)".into(),
+        };
+        Self::General(
+            Box::new(GeneralRun::loaded(Arc::new(solver), state, inner)),
+            loading,
+        )
     }
 
     /// The state a history starts from.

@@ -434,7 +434,7 @@ pub(crate) fn solve_from<'a>(
                 at_times: vec![None; scenario.snapshots.len()],
                 handovers: HandoverLog::default(),
                 fatigue: scenario.history.as_ref().filter(|_| scenario.raw.output.fatigue).map(|_| {
-                    let (centre, half_width) = normal.solved_state().contact();
+                    let (centre, half_width) = reference_contact(scenario, &normal.solved_state());
                     let grid = field_points(centre, half_width, scenario.raw.output.field_points);
                     FatigueAnalysis::new(grid, half_width)
                 }),
@@ -523,19 +523,24 @@ pub(crate) fn solve_from<'a>(
             summary.stopped_when_settled = stopped_when_settled;
             summary
         });
-    // Sampled fields: the end of normal loading, then each snapshot time reached.
+    // Sampled fields: the end of normal loading, then each snapshot time reached. A state
+    // without contact (the unloaded start, a punch lifted off) on the run's reference grid.
+    let loaded = normal.solved_state();
+    let reference = reference_contact(scenario, &loaded);
     let sample = |state: &SolvedState| -> Vec<SurfacePoint> {
-        let (centre, half_width) = state.contact();
+        let (centre, half_width) = match state.contact() {
+            (_, 0.0) => reference,
+            contact => contact,
+        };
         field_points(centre, half_width, scenario.raw.output.field_points)
             .into_iter()
             .map(|x| state.surface_point(model, x))
             .collect()
     };
-    let loaded = normal.solved_state();
-    // The fields below the surface at the same instants, on a grid in units of the normal
-    // loading's half-width; a state whose fields cannot be computed gets a warning instead.
+    // The fields below the surface at the same instants, on a grid in units of the reference
+    // half-width; a state whose fields cannot be computed gets a warning instead.
     let subsurface = scenario.raw.output.subsurface.as_ref().and_then(|raw| {
-        SubsurfaceOutput::new(&model.material, raw, loaded.contact().1)
+        SubsurfaceOutput::new(&model.material, raw, reference.1)
             .map_err(|e| warnings.push(format!("the fields below the surface are not written: {e}")))
             .ok()
     });
@@ -561,7 +566,11 @@ pub(crate) fn solve_from<'a>(
     };
     let mut fields = vec![FieldSet {
         stem: "normal_loading".into(),
-        label: "end of normal loading".into(),
+        label: if scenario.normal_load > 0.0 {
+            "end of normal loading".into()
+        } else {
+            "start (the unloaded punch)".into()
+        },
         points: sample(&loaded),
         ends: zone_ends(&loaded, &normal.record(0.0)),
         subsurface: below("normal_loading", &loaded),
@@ -598,7 +607,7 @@ pub(crate) fn solve_from<'a>(
             material: model.material,
             load_history: scenario.history.clone(),
         },
-        derived: derived(model, scenario.normal_load),
+        derived: derived(model, scenario.reference_load),
         normal_loading: normal_summary(model, &normal),
         history: history_summary,
         snapshots: snapshot_rows,
@@ -711,7 +720,7 @@ fn snapshot_fields(
     last: Option<&StepRecord>,
     warnings: &mut Vec<String>,
 ) -> (Vec<FieldSet>, Vec<SnapshotSummary>) {
-    let limit = scenario.model.friction * scenario.normal_load;
+    let limit = scenario.model.friction * scenario.reference_load;
     let mut fields = Vec::new();
     let mut rows = Vec::new();
     for (&t, kept) in scenario.snapshots.iter().zip(at_times) {
@@ -766,7 +775,7 @@ pub(crate) fn write_solution(
         plots,
         ..
     } = solution;
-    let limit = scenario.model.friction * scenario.normal_load;
+    let limit = scenario.model.friction * scenario.reference_load;
     let scales = plot_scales(scenario, summary);
     let mut sections = Vec::new();
     folder.write(
@@ -814,10 +823,13 @@ pub(crate) fn write_solution(
             }
             Ok(())
         };
-        section(
-            "End of normal loading",
-            normal_loading_plots(&fields[0].points, &fields[0].ends, &scales),
-        )?;
+        // A history from the unloaded punch has no normal loading to draw.
+        if scenario.normal_load > 0.0 {
+            section(
+                "End of normal loading",
+                normal_loading_plots(&fields[0].points, &fields[0].ends, &scales),
+            )?;
+        }
         section(
             "Load history",
             plots
@@ -861,18 +873,47 @@ pub(crate) fn write_solution(
     folder.commit()
 }
 
-/// The field plots' scales: the end of normal loading's, unless the scenario asks for SI.
+/// The field plots' scales, unless the scenario asks for SI: the end of normal loading's
+/// half-width and peak pressure, or, for a history from the unloaded punch, those of the
+/// frictionless contact at its largest P (a and 2P/(πa)).
 fn plot_scales(scenario: &Scenario, summary: &Summary) -> PlotScales {
     let n = &summary.normal_loading;
+    let load = scenario.reference_load;
+    let (a, p0) = if n.half_width > 0.0 {
+        (n.half_width, n.peak_pressure)
+    } else {
+        let a = frictionless_half_width(scenario);
+        (a, 2.0 * load / (std::f64::consts::PI * a))
+    };
     match scenario.raw.output.plot_units {
         crate::scenario::PlotUnits::Si => PlotScales::SI,
         crate::scenario::PlotUnits::Normalised => PlotScales::normalised(
-            n.half_width,
-            n.peak_pressure,
+            a,
+            p0,
             scenario.model.friction,
-            n.pressure_charge / scenario.normal_load,
+            scenario.model.pressure_charge(load) / load,
         ),
     }
+}
+
+/// The contact `(centre, half-width)` that places a run's grids (the fatigue indicators' field
+/// points, the samples of a state without contact, the fields below the surface): that of the
+/// end of normal loading `loaded`, or, for a history from the unloaded punch, the frictionless
+/// contact at its largest P about x = 0 ([`Scenario::reference_load`]).
+fn reference_contact(scenario: &Scenario, loaded: &SolvedState) -> (f64, f64) {
+    match loaded.contact() {
+        (_, 0.0) => (0.0, frictionless_half_width(scenario)),
+        contact => contact,
+    }
+}
+
+/// The frictionless half-width at [`Scenario::reference_load`] (m), with the pressure
+/// compliance of the punch's electrode.
+fn frictionless_half_width(scenario: &Scenario) -> f64 {
+    let (model, load) = (&scenario.model, scenario.reference_load);
+    model
+        .profile
+        .frictionless_half_width(load, model.pressure_compliance(model.charge_split(load)))
 }
 
 /// `failure.json`: the error, the last accepted step and the state after it (none when normal

@@ -28,8 +28,13 @@ pub struct Scenario {
     pub name: String,
     /// The contact model.
     pub model: ContactModel,
-    /// Normal load P (N/m).
+    /// Normal load P of the normal loading (N/m); 0 where the history starts from the
+    /// unloaded punch.
     pub normal_load: f64,
+    /// The normal load that scales the run (N/m): `normal_load`, or the largest P of a history
+    /// that starts from the unloaded punch (its `max_step`, Q as a fraction of ηP, the derived
+    /// constants, the plots' scales and the grids of the fields).
+    pub reference_load: f64,
     /// M.
     pub collocation_points: usize,
     /// Which solver takes the tangential steps (`numerics.solver`).
@@ -343,6 +348,7 @@ fn build(
         name: raw.name.clone(),
         model,
         normal_load: raw.normal_load,
+        reference_load: reference_load(raw.normal_load, raw.tangential_history.as_ref()),
         collocation_points: raw.numerics.collocation_points,
         solver: raw.numerics.solver,
         history,

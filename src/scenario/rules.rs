@@ -223,7 +223,11 @@ pub(super) fn table_reach(
 /// Punch radius, loads, datum distance and friction.
 pub(super) fn validate_loads(issues: &mut Vec<Issue>, raw: &RawScenario) {
     validate_profile(issues, raw);
-    positive(issues, "normal_load", raw.normal_load, "N/m");
+    if raw.normal_load != 0.0 {
+        positive(issues, "normal_load", raw.normal_load, "N/m");
+    } else {
+        validate_unloaded_start(issues, raw);
+    }
     positive(issues, "reference_distance", raw.reference_distance, "m");
     if !(raw.friction.is_finite() && raw.friction >= 0.0) {
         issues.push(Issue::new(
@@ -363,6 +367,65 @@ fn history_columns(issues: &mut Vec<Issue>, h: &RawHistory, electric: Option<f64
     columns
 }
 
+/// `normal_load` = 0: the history starts from the unloaded punch, so its points must give P
+/// (a third column) and press the punch somewhere; a charge-controlled punch starts without
+/// charge (its charge rises in the history's fourth column). The general solver takes its
+/// steps (the rule on a history that changes P rejects `numerics.solver` = "spectral").
+fn validate_unloaded_start(issues: &mut Vec<Issue>, raw: &RawScenario) {
+    let Some(h) = &raw.tangential_history else {
+        issues.push(Issue::new(
+            "normal_load",
+            "0 N/m is invalid without a `tangential_history`; it must be > 0, or 0 with a history \
+             whose points give P (the punch starts unloaded and the history presses it)",
+        ));
+        return;
+    };
+    let columns = h.points.first().or(h.cycle.first()).map_or(2, Vec::len);
+    if columns < 3 {
+        issues.push(Issue::new(
+            "normal_load",
+            "0 N/m is invalid with a history of [t, Q] points; it must be > 0, or 0 with points \
+             [t, Q, P] (or [t, Q, P, electric load]) that give P",
+        ));
+    } else if !h.points.iter().chain(&h.cycle).any(|p| p[2] > 0.0) {
+        issues.push(Issue::new(
+            "normal_load",
+            "0 N/m is invalid with a history whose P is 0 throughout; some point must press the \
+             punch (P > 0)",
+        ));
+    }
+    // `numerics.solver` = "spectral": the rule on a history that changes P says so.
+    if let RawElectrode::Conducting {
+        charge: Some(g), ..
+    } = &raw.punch.electrode
+        && *g != 0.0
+    {
+        issues.push(Issue::new(
+            "punch.electrode.charge",
+            format!(
+                "{g} C/m is invalid with `normal_load` 0; it must be 0 (a punch that starts off \
+                 the half-plane carries no charge to it; raise Γ in the history's fourth column)"
+            ),
+        ));
+    }
+}
+
+/// The normal load that scales a run (`max_step`, Q as a fraction of ηP, the plots):
+/// `normal_load`, or, for a history from the unloaded punch (`normal_load` 0), the largest P
+/// of its points.
+pub(super) fn reference_load(normal_load: f64, h: Option<&RawHistory>) -> f64 {
+    if normal_load != 0.0 {
+        return normal_load;
+    }
+    h.map_or(0.0, |h| {
+        h.points
+            .iter()
+            .chain(&h.cycle)
+            .map(|p| column(p, 2, 0.0))
+            .fold(0.0, f64::max)
+    })
+}
+
 /// Check a history's size from its segments, then expand and check it. `electric` is the
 /// electric load of the normal loading (Γ or φ0 of a conducting punch; `None` without one).
 pub(super) fn resolve_history(
@@ -371,7 +434,7 @@ pub(super) fn resolve_history(
     (friction, normal_load): (f64, f64),
     electric: Option<f64>,
 ) -> CheckedHistory {
-    let limit = friction * normal_load;
+    let limit = friction * reference_load(normal_load, Some(h));
     let columns = history_columns(issues, h, electric);
     // Q of a point in N/m (a fraction of η times the point's own P), or δ in m.
     let q_of = |p: &[f64]| match h.unit {

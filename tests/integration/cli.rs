@@ -520,7 +520,7 @@ fn run_scenario(name: &str) -> (tempfile::TempDir, PathBuf, Summary) {
 }
 
 /// The scenarios with a test of their own below; a file in `scenarios/` without one fails.
-const SCENARIOS: [&str; 20] = [
+const SCENARIOS: [&str; 21] = [
     "baseline",
     "bulk_stress",
     "charge_history",
@@ -533,6 +533,7 @@ const SCENARIOS: [&str; 20] = [
     "figure5_frictionless",
     "flat_punch_fretting",
     "fretting_fatigue",
+    "from_unloaded",
     "insulating",
     "many_cycles",
     "normal_load_in_phase",
@@ -654,6 +655,60 @@ fn scenario_normal_load_in_phase() {
         work[1] > 0.0 && (work[2] / work[1] - 1.0).abs() < 1e-2,
         "{work:?}"
     );
+}
+
+/// A history from the unloaded punch (`normal_load` 0): step 0 is the unloaded state (a = 0,
+/// zero fields, `summary.json`'s `normal_loading` with a = 0 and no stick ratio, no normal
+/// loading plots), the general solver takes every step, and the run ends with its cycles.
+/// (Its numbers against Spence's start: `load_paths::a_history_from_the_unloaded_punch_…`.)
+#[test]
+fn scenario_from_unloaded() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let o = fretsim()
+        .arg("run")
+        .arg(scenario_path("from_unloaded"))
+        .arg("--out")
+        .arg(&out)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("from the unloaded punch"));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let n = &summary["normal_loading"];
+    assert_eq!(n["half_width"].as_f64(), Some(0.0));
+    assert!(n["stick_ratio"].is_null());
+    assert_eq!(n["solver"].as_str(), Some("general"));
+    // The derived constants at the history's largest P.
+    let gamma1 = summary["derived"]["pressure_charge"].as_f64().unwrap();
+    assert!((gamma1 - 5.0020e-7).abs() < 1e-10, "{gamma1}");
+    let (fh, fields) = read_csv(&out.join("fields/normal_loading.csv"));
+    let x = column(&fh, &fields, "x_m");
+    assert!(column(&fh, &fields, "p_Pa").iter().all(|&p| p == 0.0));
+    // On the grid of the frictionless contact at P = 2000 N/m (a = 4.18e−5 m): ±2a.
+    assert!(
+        x[0] < -8.0e-5 && x[x.len() - 1] > 8.0e-5,
+        "{} {}",
+        x[0],
+        x[x.len() - 1]
+    );
+    let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        !index.contains("End of normal loading")
+            && !out.join("plots/normal_loading_tractions.svg").exists()
+    );
+    let (header, rows) = read_csv(&out.join("steps.csv"));
+    let a = column(&header, &rows, "a_m");
+    assert_eq!(a[0], 0.0);
+    assert!(a[1] > 0.0 && a[1] < a[40]);
+    assert_eq!(
+        summary["solver"]["general_steps"].as_u64(),
+        Some(rows.len() as u64 - 1)
+    );
+    let (_, cycles) = read_csv(&out.join("cycles.csv"));
+    assert_eq!(cycles.len(), 2);
 }
 
 /// Displacement control into gross slip (`"unit": "metre"`): the general solver takes every
