@@ -30,6 +30,16 @@
 //! steps of [`RATIO`], on a mesh graded as a handover's is (elements of
 //! [`END_SIZE`]·a at the contact ends, [`STICK_SIZE`]·a at every zone end, band `±1.25a`),
 //! gives the state. The mesh is symmetric about the punch axis, as the loading is.
+//!
+//! # From the unloaded punch
+//! A scenario with `normal_load` 0 has no normal loading: its history starts from the punch
+//! touching the undeformed surface with no load ([`NormalEnd::solve`] gives the general
+//! solver's state without contact, [`crate::contact::general::Solver::separated`]), and the
+//! history's own steps press it, in the history's steps (uniform in P along a segment) rather
+//! than the geometric ones above, with the state carried from each step's mesh to the next.
+//! The spectral solver has no state to offer there, so the general solver holds every step.
+//! Under proportional P and Γ the stick zone converges to Spence's at first order in the step
+//! (test `normal_loading_from_the_unloaded_punch_converges_to_spences_state`).
 
 use std::sync::Arc;
 

@@ -215,6 +215,35 @@ mod tests {
         continue_from_every_checkpoint(SolverChoice::General, 3);
     }
 
+    /// A run from the unloaded punch (`normal_load` 0): the state a checkpoint holds is the
+    /// general solver's from the first step, whose mesh is made for the contact it presses.
+    #[test]
+    fn a_run_from_the_unloaded_punch_continued_from_a_checkpoint_takes_the_same_steps() {
+        let raw = crate::scenario::parse(
+            r#"{ "name": "from_zero",
+              "material": { "kind": "elastic", "shear_modulus": 27.3e9, "poisson_ratio": 0.3 },
+              "punch": { "radius": 0.01 }, "friction": 0.3, "normal_load": 0.0,
+              "tangential_history": { "unit": "newton_per_metre",
+                "points": [[0, 0, 0], [1, 300, 2240], [2, -100, 2240], [3, 300, 2240]],
+                "steps_per_segment": 5, "max_step": 1000 } }"#,
+            std::path::Path::new("<test>"),
+        )
+        .expect("parses");
+        let sc = crate::scenario::validate(raw).expect("valid");
+        let disc = Discretisation::new(sc.collocation_points);
+        let start = crate::history::NormalEnd::solve(
+            &sc.model,
+            &disc,
+            sc.normal_load,
+            SolverChoice::Auto,
+            crate::history::general::INNER_SIZE,
+        )
+        .unwrap()
+        .history_state();
+        assert!(start.driver.is_none());
+        continue_from_every_checkpoint_of(&sc, start, SolverChoice::Auto, 3);
+    }
+
     /// A run whose normal loading the general solver took (no spectral driver in the state).
     #[test]
     fn a_run_loaded_by_the_general_solver_continued_from_a_checkpoint_takes_the_same_steps() {

@@ -18,7 +18,8 @@ pub struct RawScenario {
     pub punch: RawPunch,
     /// Coulomb friction coefficient η (–), ≥ 0.
     pub friction: f64,
-    /// Normal load P (N/m), > 0.
+    /// Normal load P of the normal loading (N/m), > 0; or 0: the history (whose points must
+    /// give P) starts from the unloaded punch.
     pub normal_load: f64,
     /// Datum distance d of the regularised log kernel (m), > 0 (default 0.01 m).
     #[serde(default = "default_reference_distance")]
@@ -198,7 +199,8 @@ pub(super) fn default_field_points() -> usize {
 #[serde(rename_all = "snake_case")]
 pub enum LoadUnit {
     /// Q as a fraction of ηP (default), with P the point's normal load where the history gives
-    /// one, else `normal_load`; `max_step` as a fraction of η·`normal_load`.
+    /// one, else `normal_load`; `max_step` as a fraction of η·`normal_load` (of η times the
+    /// history's largest P where `normal_load` is 0).
     #[default]
     FractionOfLimit,
     /// Q in N/m.
