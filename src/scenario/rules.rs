@@ -387,6 +387,7 @@ fn validate_unloaded_start(issues: &mut Vec<Issue>, raw: &RawScenario) {
             "0 N/m is invalid with a history of [t, Q] points; it must be > 0, or 0 with points \
              [t, Q, P] (or [t, Q, P, electric load]) that give P",
         ));
+        return;
     } else if !h.points.iter().chain(&h.cycle).any(|p| p[2] > 0.0) {
         issues.push(Issue::new(
             "normal_load",
