@@ -1512,7 +1512,7 @@ fn bad_input_exits_2_names_the_field_and_writes_nothing() {
         (
             with("normal_load", json!(0.0)),
             "normal_load",
-            "must be finite and > 0",
+            "must be > 0, or 0 with points [t, Q, P]",
         ),
         (
             with("normal_load", json!(-2000.0)),
