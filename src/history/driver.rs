@@ -63,6 +63,11 @@ pub struct DriverState {
     traces: Traces,
     /// How the last phase that began with mixed slip signs began ([`PhaseStart`]).
     last_start: Option<PhaseStart>,
+    /// The phase and the number of take-backs of the general solver's state lost in it (the
+    /// spectral solver failed the step right after it took the state back), which postpone
+    /// its next try ([`crate::history::GeneralRun::take_back_lost`]).
+    #[serde(default)]
+    lost_take_backs: (usize, usize),
 }
 
 impl DriverState {
@@ -94,7 +99,17 @@ impl DriverState {
             first_centre_slope: None,
             traces: Traces::default(),
             last_start: None,
+            lost_take_backs: (0, 0),
         }
+    }
+
+    /// A take-back of the general solver's state in the current phase was lost: the number
+    /// lost before it in the phase (0 for the first).
+    pub fn take_back_lost(&mut self) -> usize {
+        let (phase, count) = self.lost_take_backs;
+        let before = if phase == self.phase { count } else { 0 };
+        self.lost_take_backs = (self.phase, before + 1);
+        before
     }
 }
 

@@ -271,7 +271,7 @@ pub struct GeneralRun {
     /// after the handover's own step the try would be the step the spectral solver just failed
     /// (or that the general solver's check contradicted), from the same state. A run handed
     /// over at the first step after a take-back ([`GeneralRun::take_back_lost`]) starts at
-    /// [`GeneralRun::LOST_TAKE_BACK_WAIT`].
+    /// [`GeneralRun::LOST_TAKE_BACK_WAIT`] or more.
     resume_at: usize,
     /// Largest element of a mesh made for a new normal or electric load, relative to a
     /// (`numerics.general_element_size`).
@@ -468,18 +468,29 @@ impl GeneralRun {
     }
 
     /// General steps before the first try to take the state back in a run handed over at the
-    /// first step after a take-back ([`GeneralRun::take_back_lost`]), in place of 2.
+    /// first step after a take-back ([`GeneralRun::take_back_lost`]), in place of 2: after
+    /// the first take-back lost in a phase.
     pub const LOST_TAKE_BACK_WAIT: usize = 4;
+
+    /// The most general steps before such a try (after the fifth take-back lost in a phase).
+    pub const LONGEST_LOST_TAKE_BACK_WAIT: usize = 64;
 
     /// The run was handed over at the first step after the spectral solver took the state
     /// back: that take-back did not hold, and one at the next try would most likely not hold
     /// either (the general solver's state passes for a spectral one at some steps of the phase
     /// and not at the next, e.g. an end layer of reversed slip about one element thick that
     /// comes and goes), each time at the cost of a failed spectral step. The next try is due
-    /// after [`GeneralRun::LOST_TAKE_BACK_WAIT`] steps instead of 2 (then doubled as after any
-    /// failed try), and at the end of the phase as always.
-    pub fn take_back_lost(&mut self) {
-        self.resume_at = self.resume_at.max(Self::LOST_TAKE_BACK_WAIT);
+    /// after [`GeneralRun::LOST_TAKE_BACK_WAIT`] steps instead of 2, doubled for each earlier
+    /// take-back lost in the same phase (`lost_before`, counted by the driver:
+    /// [`DriverState::take_back_lost`]) up to [`GeneralRun::LONGEST_LOST_TAKE_BACK_WAIT`], then
+    /// doubled after any failed try, and at the end of the phase as always. (A phase whose end
+    /// layer comes and goes every few steps otherwise costs a failed spectral step every four
+    /// steps: 67 handovers in the 788 steps of the failure map's PZT-4 run at the potential of
+    /// Γ = 6e−7 C/m, η = 0.05, variable amplitude.)
+    pub fn take_back_lost(&mut self, lost_before: usize) {
+        let wait = (Self::LOST_TAKE_BACK_WAIT << lost_before.min(4))
+            .min(Self::LONGEST_LOST_TAKE_BACK_WAIT);
+        self.resume_at = self.resume_at.max(wait);
     }
 
     /// The solver.

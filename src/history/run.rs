@@ -464,7 +464,7 @@ fn spectral_stretch(
                 )
             {
                 if k == 0 && after_take_back {
-                    taken.0.take_back_lost();
+                    taken.0.take_back_lost(driver.take_back_lost());
                 }
                 return Some(Stop {
                     at: k,
@@ -487,7 +487,10 @@ fn spectral_stretch(
                 }
                 Err(failure) => {
                     let taken = (k == 0 && after_take_back)
-                        .then(|| take_back_lost(model, driver, (point, options), recall))
+                        .then(|| {
+                            let lost_before = driver.take_back_lost();
+                            take_back_lost(model, driver, (point, options, lost_before), recall)
+                        })
                         .flatten();
                     return Some(Stop {
                         at: k,
@@ -515,17 +518,18 @@ fn spectral_stretch(
 
 /// The general solver's run and record of the step at `point`, which the spectral solver
 /// failed right after it took the state back (`resumes`), handed over from the driver's state
-/// with its next try postponed ([`GeneralRun::take_back_lost`]); `None` when the general solver
-/// cannot take the step either (the caller's handover then meets that failure).
+/// with its next try postponed ([`GeneralRun::take_back_lost`], after `lost_before` take-backs
+/// lost earlier in the phase); `None` when the general solver cannot take the step either (the
+/// caller's handover then meets that failure).
 fn take_back_lost(
     model: &ContactModel,
     driver: &DriverState,
-    (point, options): (LoadPoint, RunOptions),
+    (point, options, lost_before): (LoadPoint, RunOptions, usize),
     recall: &mut Recall,
 ) -> Option<(GeneralRun, StepRecord)> {
     let mut run = GeneralRun::handover(model, driver, options.general_element_size, recall);
     let record = run.step(model, point, recall).ok()?;
-    run.take_back_lost();
+    run.take_back_lost(lost_before);
     Some((run, record))
 }
 
