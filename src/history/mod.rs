@@ -46,9 +46,10 @@
 //! of every phase, where thin end zones that slip the old way form in a coupled contact, and
 //! the spectral solver's step is handed over when the two disagree. The spectral solver tries
 //! to take the state back after 2, 4, 8, … general steps of the phase and at its last step (a
-//! try costs about as much as a spectral step that fails, many general steps; under `auto` a
-//! spectral step gives up after a bound on its residual evaluations,
-//! `SlipOptions::step_evaluations`). Each record says which solver took
+//! try gives up after 100 residual evaluations, a step under `auto` after
+//! `SlipOptions::step_evaluations`; a failed one costs several general steps). A take-back
+//! lost at the next step postpones the next try by 4 general steps, doubled for each one lost
+//! before in the phase, up to 64 (`GeneralRun::take_back_lost`). Each record says which solver took
 //! the step ([`SolverKind`]) and the zone structure ([`ZoneCount`]). Where the spectral
 //! solver has no normal-loading state, the general solver loads the contact by steps and
 //! holds every step of the history ([`NormalEnd`]; the state then has no spectral driver).
