@@ -393,10 +393,12 @@ fn resumes(
 /// step's [`SlipOptions::step_evaluations`] (600 under `auto`). A try is optional: the general
 /// solver holds the step either way, so a try that would need more only leaves the state with
 /// it a few steps longer, while a try that fails costs its whole budget. On the failure map's
-/// PZT-4 runs at the potential of Γ = 6e−7 C/m: η = 0.05, variable amplitude (788 steps)
-/// 56.6 s with 600 evaluations a try and 40 handovers, 20.5 s with 100 and 11; η = 0.1,
-/// non-zero mean (1,972 steps) 17.5 s against 38.7 s before the lost take-backs were
-/// counted. The default run takes the same steps with either bound.
+/// PZT-4 runs at the potential of Γ = 6e−7 C/m, η = 0.05, variable amplitude (788 steps):
+/// 77.0 s and 67 handovers with 600 evaluations a try and every lost take-back waited for 4
+/// steps, 56.6 s and 40 with the waits doubled ([`GeneralRun::take_back_lost`]), 20.5 s and 11
+/// with this bound too; η = 0.1, non-zero mean (1,972 steps): 38.7 s and 74 handovers, then
+/// 17.5 s and 16 with both (13.6 s under `general` alone). The default run takes the same
+/// steps with either bound.
 const TAKE_BACK_EVALUATIONS: usize = 100;
 
 /// Where the spectral solver stopped: the index of the step it did not take, why, and the
