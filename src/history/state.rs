@@ -229,25 +229,22 @@ mod tests {
             std::path::Path::new("<test>"),
         )
         .expect("parses");
-        let sc = crate::scenario::validate(raw).expect("valid");
-        let disc = Discretisation::new(sc.collocation_points);
-        let start = crate::history::NormalEnd::solve(
-            &sc.model,
-            &disc,
-            sc.normal_load,
-            SolverChoice::Auto,
-            crate::history::general::INNER_SIZE,
-        )
-        .unwrap()
-        .history_state();
-        assert!(start.driver.is_none());
-        continue_from_every_checkpoint_of(&sc, start, SolverChoice::Auto, 3);
+        continue_from_every_checkpoint_without_a_driver(
+            &crate::scenario::validate(raw).expect("valid"),
+        );
     }
 
     /// A run whose normal loading the general solver took (no spectral driver in the state).
     #[test]
     fn a_run_loaded_by_the_general_solver_continued_from_a_checkpoint_takes_the_same_steps() {
-        let sc = crate::history::default_scenario_with(0.1, 2e-7);
+        continue_from_every_checkpoint_without_a_driver(&crate::history::default_scenario_with(
+            0.1, 2e-7,
+        ));
+    }
+
+    /// [`continue_from_every_checkpoint_of`] for a scenario whose run starts from the general
+    /// solver's state (its normal loading, or the unloaded punch), under `auto`.
+    fn continue_from_every_checkpoint_without_a_driver(sc: &crate::scenario::Scenario) {
         let disc = Discretisation::new(sc.collocation_points);
         let start = crate::history::NormalEnd::solve(
             &sc.model,
@@ -259,6 +256,6 @@ mod tests {
         .unwrap()
         .history_state();
         assert!(start.driver.is_none());
-        continue_from_every_checkpoint_of(&sc, start, SolverChoice::Auto, 3);
+        continue_from_every_checkpoint_of(sc, start, SolverChoice::Auto, 3);
     }
 }
