@@ -27,6 +27,29 @@ impl PlotScales {
         charge: 0.0,
     };
 
+    /// The field plots' scales, unless the scenario asks for SI: the end of normal loading's
+    /// half-width and peak pressure, or, for a history from the unloaded punch, those of the
+    /// frictionless contact at its largest P (a and 2P/(πa)).
+    pub(crate) fn of_run(scenario: &crate::Scenario, summary: &super::summary::Summary) -> Self {
+        let n = &summary.normal_loading;
+        let load = scenario.reference_load;
+        let (a, p0) = if n.half_width > 0.0 {
+            (n.half_width, n.peak_pressure)
+        } else {
+            let a = scenario.frictionless_half_width();
+            (a, 2.0 * load / (std::f64::consts::PI * a))
+        };
+        match scenario.raw.output.plot_units {
+            crate::scenario::PlotUnits::Si => PlotScales::SI,
+            crate::scenario::PlotUnits::Normalised => PlotScales::normalised(
+                a,
+                p0,
+                scenario.model.friction,
+                scenario.model.pressure_charge(load) / load,
+            ),
+        }
+    }
+
     /// The scales of a contact whose normal loading ended with half-width `a`, peak pressure
     /// `p0`, friction `eta` and charge per force `k` (C/N).
     pub fn normalised(a: f64, p0: f64, eta: f64, k: f64) -> Self {

@@ -776,7 +776,7 @@ pub(crate) fn write_solution(
         ..
     } = solution;
     let limit = scenario.model.friction * scenario.reference_load;
-    let scales = plot_scales(scenario, summary);
+    let scales = PlotScales::of_run(scenario, summary);
     let mut sections = Vec::new();
     folder.write(
         "summary.json",
@@ -873,48 +873,17 @@ pub(crate) fn write_solution(
     folder.commit()
 }
 
-/// The field plots' scales, unless the scenario asks for SI: the end of normal loading's
-/// half-width and peak pressure, or, for a history from the unloaded punch, those of the
-/// frictionless contact at its largest P (a and 2P/(πa)).
-fn plot_scales(scenario: &Scenario, summary: &Summary) -> PlotScales {
-    let n = &summary.normal_loading;
-    let load = scenario.reference_load;
-    let (a, p0) = if n.half_width > 0.0 {
-        (n.half_width, n.peak_pressure)
-    } else {
-        let a = frictionless_half_width(scenario);
-        (a, 2.0 * load / (std::f64::consts::PI * a))
-    };
-    match scenario.raw.output.plot_units {
-        crate::scenario::PlotUnits::Si => PlotScales::SI,
-        crate::scenario::PlotUnits::Normalised => PlotScales::normalised(
-            a,
-            p0,
-            scenario.model.friction,
-            scenario.model.pressure_charge(load) / load,
-        ),
-    }
-}
-
 /// The contact `(centre, half-width)` that places a run's grids (the fatigue indicators' field
 /// points, the samples of a state without contact, the fields below the surface): that of the
 /// end of normal loading `loaded`, or, for a history from the unloaded punch, the frictionless
 /// contact at its largest P about x = 0 ([`Scenario::reference_load`]).
 fn reference_contact(scenario: &Scenario, loaded: &SolvedState) -> (f64, f64) {
     match loaded.contact() {
-        (_, 0.0) => (0.0, frictionless_half_width(scenario)),
+        (_, 0.0) => (0.0, scenario.frictionless_half_width()),
         contact => contact,
     }
 }
 
-/// The frictionless half-width at [`Scenario::reference_load`] (m), with the pressure
-/// compliance of the punch's electrode.
-fn frictionless_half_width(scenario: &Scenario) -> f64 {
-    let (model, load) = (&scenario.model, scenario.reference_load);
-    model
-        .profile
-        .frictionless_half_width(load, model.pressure_compliance(model.charge_split(load)))
-}
 
 /// `failure.json`: the error, the last accepted step and the state after it (none when normal
 /// loading failed; the state as a checkpoint holds it, [`crate::history::HistoryState`]).

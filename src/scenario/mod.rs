@@ -50,6 +50,18 @@ pub struct Scenario {
     pub raw: RawScenario,
 }
 
+impl Scenario {
+    /// The frictionless half-width at [`Scenario::reference_load`] (m), with the pressure
+    /// compliance of the punch's electrode: the size of the contact that places a history's
+    /// grids and scales its plots where no normal loading gives one (`normal_load` 0).
+    pub fn frictionless_half_width(&self) -> f64 {
+        let (model, load) = (&self.model, self.reference_load);
+        model
+            .profile
+            .frictionless_half_width(load, model.pressure_compliance(model.charge_split(load)))
+    }
+}
+
 /// The built-in default: the seed paper's baseline (PZT-4, conducting punch, R = 60 mm,
 /// P = 2000 N/m, Γ = 6e−7 C/m, η = 0.3), normal loading then three cycles of ±0.5 ηP.
 pub const DEFAULT_SCENARIO: &str = r#"{
