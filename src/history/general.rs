@@ -774,3 +774,28 @@ impl Increments {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::pressure::Discretisation;
+
+    /// Take-backs lost again and again in one phase postpone the next try by 4, 8, 16, 32,
+    /// 64 and then 64 general steps; in the next phase the first one lost waits 4 again.
+    #[test]
+    fn take_backs_lost_in_one_phase_wait_twice_as_long_each_time() {
+        let sc = crate::scenario::default_scenario();
+        let disc = Discretisation::new(sc.collocation_points);
+        let mut driver = crate::history::driver_after_normal_loading(&sc, &disc);
+        let mut recall = Recall::new(false);
+        let mut lose = |driver: &mut DriverState| {
+            let mut run = GeneralRun::handover(&sc.model, driver, INNER_SIZE, &mut recall);
+            run.take_back_lost(driver.take_back_lost());
+            run.resume_at
+        };
+        let waits: Vec<usize> = (0..6).map(|_| lose(&mut driver)).collect();
+        assert_eq!(waits, [4, 8, 16, 32, 64, 64]);
+        driver.phase += 1;
+        assert_eq!(lose(&mut driver), 4);
+    }
+}
