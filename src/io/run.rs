@@ -405,6 +405,9 @@ pub(crate) fn solve_from<'a>(
     let mut records = Vec::new();
     let mut failure = None;
     let mut failure_state = None;
+    // The end of normal loading, and the contact that places the run's grids.
+    let loaded = normal.solved_state();
+    let reference = reference_contact(scenario, &loaded);
     let (kept, resumed) = match resume {
         Some(Resume {
             step,
@@ -434,7 +437,7 @@ pub(crate) fn solve_from<'a>(
                 at_times: vec![None; scenario.snapshots.len()],
                 handovers: HandoverLog::default(),
                 fatigue: scenario.history.as_ref().filter(|_| scenario.raw.output.fatigue).map(|_| {
-                    let (centre, half_width) = reference_contact(scenario, &normal.solved_state());
+                    let (centre, half_width) = reference;
                     let grid = field_points(centre, half_width, scenario.raw.output.field_points);
                     FatigueAnalysis::new(grid, half_width)
                 }),
@@ -525,8 +528,6 @@ pub(crate) fn solve_from<'a>(
         });
     // Sampled fields: the end of normal loading, then each snapshot time reached. A state
     // without contact (the unloaded start, a punch lifted off) on the run's reference grid.
-    let loaded = normal.solved_state();
-    let reference = reference_contact(scenario, &loaded);
     let sample = |state: &SolvedState| -> Vec<SurfacePoint> {
         let (centre, half_width) = match state.contact() {
             (_, 0.0) => reference,
