@@ -388,7 +388,13 @@ fn validate_unloaded_start(issues: &mut Vec<Issue>, raw: &RawScenario) {
              [t, Q, P] (or [t, Q, P, electric load]) that give P",
         ));
         return;
-    } else if !h.points.iter().chain(&h.cycle).any(|p| p[2] > 0.0) {
+    }
+    if !h
+        .points
+        .iter()
+        .chain(&h.cycle)
+        .any(|p| column(p, 2, 0.0) > 0.0)
+    {
         issues.push(Issue::new(
             "normal_load",
             "0 N/m is invalid with a history whose P is 0 throughout; some point must press the \

@@ -924,6 +924,11 @@ fn a_zero_normal_load_needs_a_history_that_presses_the_punch() {
         paths(&with(&history("[[0, 0, 0], [1, 0, 0]]"), "")),
         ["normal_load"]
     );
+    // A point without the P column of the first: its own rule, and no panic.
+    assert_eq!(
+        paths(&with(&history("[[0, 0, 0], [1, 0]]"), "")),
+        ["normal_load", "tangential_history.points[1]"]
+    );
     let pressed = history("[[0, 0, 0, 0], [1, 0, 2000, 6e-7]]");
     assert_eq!(
         paths(&with(&pressed, r#", "numerics": { "solver": "spectral" }"#)),
