@@ -87,7 +87,10 @@ pub fn point_sample(
 }
 
 /// Nodes of the graded rule on the pieces of a slip zone between two grid points
-/// ([`crate::history::slip_increments`]).
+/// ([`crate::history::slip_increments`]). Measured on the default history at M = 64 on the
+/// default grid (400 points over ±2a) against 64 nodes: the slip increments within 4.8e−14 of
+/// the step's largest (test `the_grid_rule_gives_the_slip_increments_to_a_small_error`; the
+/// plain Gauss–Legendre rule of 8 or 6 nodes on these pieces gave 1.1e−9 and 9.7e−8).
 pub const GRID_PIECE_NODES: usize = 16;
 
 /// The samples of a step at the grid points `grid`, from the state before it (`None` at the
