@@ -23,6 +23,8 @@
 //! run is abandoned at the first step after it: "timeout") and with `spectral` under a smaller
 //! cap (`--spectral-cap-s`). One row per run goes to `results.csv`, flushed as it is written;
 //! `summary.md` is rewritten from `results.csv` at the end (or with `--summarise`).
+//! `--only FILE` runs only the drawn points whose ids the file lists, one a line: the timeouts
+//! of a draw, for example, again with a longer cap into another folder.
 //!
 //! The example writes files, so it is not the numerical core: it only calls
 //! `fretsim::parse`, `fretsim::validate` and `fretsim::solve`.
@@ -797,12 +799,15 @@ struct Options {
     fine_share: f64,
     summarise_only: bool,
     dry_run: bool,
+    /// Run only the drawn points whose ids this file lists (one a line).
+    only: Option<PathBuf>,
 }
 
 fn usage() -> ! {
     eprintln!(
         "usage: failure_map OUT_DIR [--runs N] [--seed S] [--budget-min MIN] [--cap-s S] \
-         [--spectral-cap-s S] [--random-share F] [--fine-share F] [--dry-run] [--summarise]"
+         [--spectral-cap-s S] [--random-share F] [--fine-share F] [--only IDS_FILE] [--dry-run] \
+         [--summarise]"
     );
     std::process::exit(2)
 }
@@ -820,6 +825,7 @@ fn parse_options() -> Options {
         fine_share: 0.15,
         summarise_only: false,
         dry_run: false,
+        only: None,
     };
     let mut out = None;
     while let Some(a) = args.next() {
@@ -841,6 +847,7 @@ fn parse_options() -> Options {
             "--fine-share" => o.fine_share = value("--fine-share"),
             "--summarise" => o.summarise_only = true,
             "--dry-run" => o.dry_run = true,
+            "--only" => o.only = Some(args.next().map(PathBuf::from).unwrap_or_else(|| usage())),
             s if !s.starts_with('-') && out.is_none() => out = Some(PathBuf::from(s)),
             _ => usage(),
         }
@@ -946,7 +953,19 @@ fn main() {
         )
         .collect();
     let points = draw(&o);
-    let todo: Vec<&Point> = points.iter().filter(|p| !done.contains(&p.id())).collect();
+    let only: Option<BTreeSet<String>> = o.only.as_ref().map(|path| {
+        fs::read_to_string(path)
+            .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
+            .lines()
+            .map(|l| l.trim().to_string())
+            .filter(|l| !l.is_empty())
+            .collect()
+    });
+    let todo: Vec<&Point> = points
+        .iter()
+        .filter(|p| !done.contains(&p.id()))
+        .filter(|p| only.as_ref().is_none_or(|ids| ids.contains(&p.id())))
+        .collect();
     eprintln!(
         "{} points drawn (seed {}), {} already in {}, {} to run",
         points.len(),
