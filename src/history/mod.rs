@@ -102,6 +102,7 @@ mod record;
 mod regime;
 mod run;
 mod state;
+mod turnings;
 
 pub use general::{RunOptions, SolverChoice, SolverKind, ZoneCount};
 pub use load::{Control, LoadHistory, LoadPoint, PunchHistory, PunchLoads};
@@ -110,6 +111,7 @@ pub use record::{NoObserver, Observer, SolvedState, StateView, StepFailure, Step
 pub use regime::Regime;
 pub use run::{HistoryFailure, HistoryRun, run_history};
 pub use state::{HistoryState, HistoryStateView};
+pub use turnings::Turnings;
 
 internal_use! { driver::{DriverState, SolvedStep, Trial, Tried, finish_step, try_step}; }
 #[cfg(any(test, feature = "internals"))]

@@ -152,6 +152,7 @@ impl NormalEnd {
             Self::Spectral(normal) => HistoryState::new(DriverState::after_normal_loading(normal)),
             Self::General(run, _) => HistoryState {
                 driver: None,
+                turnings: super::turnings::Turnings::new(run.state.loads.tangential),
                 general: Some((**run).clone()),
             },
         }

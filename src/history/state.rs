@@ -15,6 +15,7 @@ use crate::contact::ContactModel;
 
 use super::driver::DriverState;
 use super::general::{GeneralRun, GeneralRunData};
+use super::turnings::Turnings;
 
 /// Everything a step needs from the past.
 #[derive(Debug, Clone)]
@@ -27,6 +28,9 @@ pub struct HistoryState {
     pub driver: Option<DriverState>,
     /// The general solver's run while it holds the steps.
     pub general: Option<GeneralRun>,
+    /// The turning points of the load still remembered, with the spectral solver's state at
+    /// each it took.
+    pub turnings: Turnings,
 }
 
 /// A [`HistoryState`] as read back, before its general solver is rebuilt.
@@ -34,6 +38,7 @@ pub struct HistoryState {
 pub struct HistoryStateData {
     driver: Option<DriverState>,
     general: Option<GeneralRunData>,
+    turnings: Turnings,
 }
 
 /// A borrowed [`HistoryState`], as a run passes it to [`super::Observer::on_checkpoint`];
@@ -44,18 +49,23 @@ pub struct HistoryStateView<'a> {
     pub driver: Option<&'a DriverState>,
     /// See [`HistoryState::general`].
     pub general: Option<&'a GeneralRun>,
+    /// See [`HistoryState::turnings`].
+    pub turnings: &'a Turnings,
 }
 
 #[derive(Serialize)]
 struct Written<'a> {
     driver: Option<&'a DriverState>,
     general: Option<&'a GeneralRun>,
+    turnings: &'a Turnings,
 }
 
 #[derive(Deserialize)]
 struct Read {
     driver: Option<DriverState>,
     general: Option<GeneralRunData>,
+    #[serde(default)]
+    turnings: Turnings,
 }
 
 impl Serialize for HistoryStateView<'_> {
@@ -63,6 +73,7 @@ impl Serialize for HistoryStateView<'_> {
         let written = Written {
             driver: self.driver,
             general: self.general,
+            turnings: self.turnings,
         };
         crate::shared::write_shared(|| written.serialize(serializer))
     }
@@ -76,9 +87,16 @@ impl Serialize for HistoryState {
 
 impl<'de> Deserialize<'de> for HistoryStateData {
     fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let Read { driver, general } =
-            crate::shared::read_shared(|| Read::deserialize(deserializer))?;
-        Ok(Self { driver, general })
+        let Read {
+            driver,
+            general,
+            turnings,
+        } = crate::shared::read_shared(|| Read::deserialize(deserializer))?;
+        Ok(Self {
+            driver,
+            general,
+            turnings,
+        })
     }
 }
 
@@ -86,6 +104,7 @@ impl HistoryState {
     /// The state at the start of a run from a driver.
     pub fn new(driver: DriverState) -> Self {
         Self {
+            turnings: Turnings::new(driver.state.tangential_load),
             driver: Some(driver),
             general: None,
         }
@@ -96,6 +115,7 @@ impl HistoryState {
         HistoryStateView {
             driver: self.driver.as_ref(),
             general: self.general.as_ref(),
+            turnings: &self.turnings,
         }
     }
 
@@ -104,6 +124,7 @@ impl HistoryState {
         Self {
             driver: data.driver,
             general: data.general.map(|run| GeneralRun::restore(model, run)),
+            turnings: data.turnings,
         }
     }
 }

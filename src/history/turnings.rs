@@ -1,0 +1,167 @@
+//! The turning points of the load that the contact still remembers, with the spectral solver's
+//! state at each one it took ([`Turnings`]): where the spectral solver resumes after the
+//! general solver held the end of a phase.
+//!
+//! # The rule
+//! Within a phase, the state depends on the remembered turning states and Q only (the
+//! spectral solver's memory, and Mindlin–Deresiewicz for an uncoupled contact). A load that
+//! goes on past the last turning point of its own direction closes the loop between that
+//! point and the turning point after it, and the contact forgets both (Masing's memory rule,
+//! the rainflow count of the load):
+//! ```text
+//! remembered  R₀ (the start), R₁, …, Rₙ        the phase under way began at Rₙ
+//! a step to Q in the direction d of the phase: while n ≥ 2 and d·Q > d·Rₙ₋₁,
+//!             forget Rₙ₋₁ and Rₙ (n ← n − 2); at n = 1, past the mirror 2R₀ − R₁ of the
+//!             first turning point, forget R₁ (the first loading's state in the other
+//!             direction)
+//! ```
+//! After the loop closed, the phase under way is the phase that ended at `Rₙ₋₁` continued
+//! (the first loading, when that was R₁): the state at Q is the one that phase reaches at Q.
+//! When the spectral solver took the step that ended it, its driver state there (kept at every
+//! turning point) can take the state back by stepping on to Q, although the general solver
+//! held the steps of the loop (whose turning states the spectral memory cannot hold); the
+//! general solver's state of the step checks it. The rule is exact for an uncoupled contact
+//! (Mindlin–Deresiewicz); on a coupled one the contact moves with Q and the check decides.
+//!
+//! The loads alone decide what is remembered; the states kept are the turning points still
+//! remembered, as many as the load's nested loops (a handful in a random history), not a
+//! number that grows with the history.
+
+use serde::{Deserialize, Serialize};
+
+use super::driver::DriverState;
+
+/// One remembered turning point.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Turning {
+    /// Q or δ at the turning point.
+    load: f64,
+    /// The spectral driver's state after the step that ended the phase there, when the
+    /// spectral solver took it.
+    driver: Option<Box<DriverState>>,
+}
+
+/// The remembered turning points of a run, oldest first (module docs).
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct Turnings {
+    remembered: Vec<Turning>,
+    /// The direction of the last change of the load (0 before the first).
+    direction: f64,
+}
+
+impl Turnings {
+    /// The start of a history at `load`.
+    pub fn new(load: f64) -> Self {
+        Self {
+            remembered: vec![Turning { load, driver: None }],
+            direction: 0.0,
+        }
+    }
+
+    /// The step from `from` to `to`: the loops it closes are forgotten. Returns the spectral
+    /// driver's state at the end of the phase that the step now continues, when a loop closed
+    /// and the spectral solver took the step that ended that phase.
+    pub fn step(&mut self, from: f64, to: f64) -> Option<Box<DriverState>> {
+        let d = (to - from).signum();
+        if to == from {
+            return None;
+        }
+        if self.remembered.is_empty() {
+            // A state read back from before the turning points were kept.
+            self.remembered.push(Turning {
+                load: from,
+                driver: None,
+            });
+        }
+        if self.direction != 0.0 && d != self.direction {
+            // `from` was a turning point the caller has not ended (a run resumed there).
+            self.end_phase(from, None);
+        }
+        self.direction = d;
+        let mut continued = None;
+        loop {
+            let n = self.remembered.len() - 1;
+            if n >= 2 && d * to > d * self.remembered[n - 1].load {
+                self.remembered.pop();
+                continued = self.remembered.pop().map(|t| t.driver);
+            } else if n == 1
+                && d * to > d * (2.0 * self.remembered[0].load - self.remembered[1].load)
+            {
+                // Past the mirror of the first turning point: the first loading's in the
+                // other direction, which no turning state of the spectral solver continues.
+                self.remembered.pop();
+                continued = None;
+            } else {
+                break;
+            }
+        }
+        continued.flatten()
+    }
+
+    /// The step that ended a phase at `load`, with the spectral driver's state after it when
+    /// the spectral solver took it.
+    pub fn end_phase(&mut self, load: f64, driver: Option<&DriverState>) {
+        let last = self.remembered.last().map(|t| t.load);
+        if last.is_some_and(|l| l.to_bits() == load.to_bits()) {
+            // Already ended there (the step after a resumed run's turning point).
+            if let (Some(t), Some(d)) = (self.remembered.last_mut(), driver) {
+                t.driver.get_or_insert_with(|| Box::new(d.clone()));
+            }
+            return;
+        }
+        self.remembered.push(Turning {
+            load,
+            driver: driver.map(|d| Box::new(d.clone())),
+        });
+    }
+
+    /// The loads remembered, oldest first.
+    pub fn loads(&self) -> Vec<f64> {
+        self.remembered.iter().map(|t| t.load).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Walk loads, ending a phase at each reversal, and return what is remembered.
+    fn walk(loads: &[f64]) -> Vec<f64> {
+        let mut t = Turnings::new(loads[0]);
+        for w in loads.windows(3) {
+            t.step(w[0], w[1]);
+            if (w[1] - w[0]) * (w[2] - w[1]) < 0.0 {
+                t.end_phase(w[1], None);
+            }
+        }
+        let n = loads.len();
+        t.step(loads[n - 2], loads[n - 1]);
+        t.loads()
+    }
+
+    /// Masing's rule on a hand-made history: a loop that closes is forgotten, a nested one
+    /// inside it first; past the first turning point or its mirror, only the start is left.
+    #[test]
+    fn a_closed_loop_is_forgotten_and_an_open_one_remembered() {
+        // 0 → 5 → −5 → 3 → −2 → 4: the loop (3, −2) closes at 4 > 3.
+        assert_eq!(
+            walk(&[0.0, 5.0, -5.0, 3.0, -2.0, 4.0]),
+            vec![0.0, 5.0, -5.0]
+        );
+        // … → 2: still inside, (3, −2) remembered.
+        assert_eq!(
+            walk(&[0.0, 5.0, -5.0, 3.0, -2.0, 2.0]),
+            vec![0.0, 5.0, -5.0, 3.0, -2.0]
+        );
+        // 0 → 5 → −5 → 3 → −2 → 1 → −1 → 4: (1, −1) then (3, −2) close.
+        assert_eq!(
+            walk(&[0.0, 5.0, -5.0, 3.0, -2.0, 1.0, -1.0, 4.0]),
+            vec![0.0, 5.0, -5.0]
+        );
+        // Past the first turning point: the first loading again, 0 → 5 → −5 → 6.
+        assert_eq!(walk(&[0.0, 5.0, -5.0, 6.0]), vec![0.0]);
+        // Past its mirror: 0 → 5 → −6.
+        assert_eq!(walk(&[0.0, 5.0, -6.0]), vec![0.0]);
+        assert_eq!(walk(&[0.0, 5.0, -4.0]), vec![0.0, 5.0]);
+    }
+}
