@@ -454,7 +454,7 @@ fn continues(
     for k in 1..=parts {
         let q = from + (point.q - from) * k as f64 / parts as f64;
         let part = LoadPoint { q, ..point };
-        let tried = try_step(model, disc, &mut driver, part, options);
+        let tried = try_step(model, disc, &driver, part, options);
         let Ok(Tried::Slip(trial)) = tried else {
             return None;
         };

@@ -62,10 +62,10 @@ impl Turnings {
     /// driver's state at the end of the phase that the step now continues, when a loop closed
     /// and the spectral solver took the step that ended that phase.
     pub fn step(&mut self, from: f64, to: f64) -> Option<Box<DriverState>> {
-        let d = (to - from).signum();
-        if to == from {
+        if (to - from).abs() <= 0.0 {
             return None;
         }
+        let d = (to - from).signum();
         if self.remembered.is_empty() {
             // A state read back from before the turning points were kept.
             self.remembered.push(Turning {
@@ -73,7 +73,7 @@ impl Turnings {
                 driver: None,
             });
         }
-        if self.direction != 0.0 && d != self.direction {
+        if d * self.direction < 0.0 {
             // `from` was a turning point the caller has not ended (a run resumed there).
             self.end_phase(from, None);
         }
