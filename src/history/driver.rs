@@ -71,6 +71,29 @@ pub struct DriverState {
 }
 
 impl DriverState {
+    /// A copy to continue the current phase from later ([`super::Turnings`]), without the
+    /// recall traces (which only make steps faster, and are the bulk of the state).
+    pub(super) fn continuation(&self) -> Self {
+        Self {
+            state: self.state.clone(),
+            memory: self.memory.clone(),
+            phase_sign: self.phase_sign,
+            phase: self.phase,
+            history: self.history.clone(),
+            base: self.base.clone(),
+            phase_start_load: self.phase_start_load,
+            displacement: self.displacement,
+            anchor: self.anchor,
+            anchor_ux: self.anchor_ux,
+            approach: self.approach,
+            warm: self.warm,
+            first_centre_slope: self.first_centre_slope,
+            traces: super::hints::Traces::default(),
+            last_start: self.last_start,
+            lost_take_backs: self.lost_take_backs,
+        }
+    }
+
     /// Start from the end of normal loading.
     pub fn after_normal_loading(normal: &NormalLoading) -> Self {
         let state = normal.state.clone();

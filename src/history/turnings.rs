@@ -10,7 +10,7 @@
 //! the rainflow count of the load):
 //! ```text
 //! remembered  R₀ (the start), R₁, …, Rₙ        the phase under way began at Rₙ
-//! a step to Q in the direction d of the phase: while n ≥ 2 and d·Q > d·Rₙ₋₁,
+//! a step to Q in the direction d of the phase: while n ≥ 2 and d·Q ≥ d·Rₙ₋₁,
 //!             forget Rₙ₋₁ and Rₙ (n ← n − 2); at n = 1, past the mirror 2R₀ − R₁ of the
 //!             first turning point, forget R₁ (the first loading's state in the other
 //!             direction)
@@ -23,13 +23,24 @@
 //! general solver's state of the step checks it. The rule is exact for an uncoupled contact
 //! (Mindlin–Deresiewicz); on a coupled one the contact moves with Q and the check decides.
 //!
-//! The loads alone decide what is remembered; the states kept are the turning points still
-//! remembered, as many as the load's nested loops (a handful in a random history), not a
-//! number that grows with the history.
+//! The loads alone decide what is remembered: as many turning points as the load's open
+//! nested loops (a handful in a random history, two in a repeated cycle), with the spectral
+//! driver's state at no more than [`KEPT_STATES`] of them.
 
 use serde::{Deserialize, Serialize};
 
 use super::driver::DriverState;
+
+/// Most driver states kept ([`Turnings::end_phase`]): a history whose amplitudes keep
+/// shrinking remembers every turning point, and a state is a few hundred kB.
+const KEPT_STATES: usize = 16;
+
+/// Whether a load going in direction `d` has reached `at` (a turning point reached again
+/// closes its loop; to round-off, so that a cycle repeated from load points computed again
+/// closes too).
+fn reaches(d: f64, load: f64, at: f64) -> bool {
+    d * (load - at) >= -1e-12 * load.abs().max(at.abs())
+}
 
 /// One remembered turning point.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -81,11 +92,15 @@ impl Turnings {
         let mut continued = None;
         loop {
             let n = self.remembered.len() - 1;
-            if n >= 2 && d * to > d * self.remembered[n - 1].load {
+            if n >= 2 && reaches(d, to, self.remembered[n - 1].load) {
                 self.remembered.pop();
                 continued = self.remembered.pop().map(|t| t.driver);
             } else if n == 1
-                && d * to > d * (2.0 * self.remembered[0].load - self.remembered[1].load)
+                && reaches(
+                    d,
+                    to,
+                    2.0 * self.remembered[0].load - self.remembered[1].load,
+                )
             {
                 // Past the mirror of the first turning point: the first loading's in the
                 // other direction, which no turning state of the spectral solver continues.
@@ -99,19 +114,37 @@ impl Turnings {
     }
 
     /// The step that ended a phase at `load`, with the spectral driver's state after it when
-    /// the spectral solver took it.
+    /// the spectral solver took it. At most [`KEPT_STATES`] driver states are kept: the first
+    /// turning point's and the most recent ones.
     pub fn end_phase(&mut self, load: f64, driver: Option<&DriverState>) {
+        self.push(load, driver);
+        let mut kept = self
+            .remembered
+            .iter()
+            .filter(|t| t.driver.is_some())
+            .count();
+        for t in self.remembered.iter_mut().skip(2) {
+            if kept <= KEPT_STATES {
+                break;
+            }
+            if t.driver.take().is_some() {
+                kept -= 1;
+            }
+        }
+    }
+
+    fn push(&mut self, load: f64, driver: Option<&DriverState>) {
         let last = self.remembered.last().map(|t| t.load);
         if last.is_some_and(|l| l.to_bits() == load.to_bits()) {
             // Already ended there (the step after a resumed run's turning point).
             if let (Some(t), Some(d)) = (self.remembered.last_mut(), driver) {
-                t.driver.get_or_insert_with(|| Box::new(d.clone()));
+                t.driver.get_or_insert_with(|| Box::new(d.continuation()));
             }
             return;
         }
         self.remembered.push(Turning {
             load,
-            driver: driver.map(|d| Box::new(d.clone())),
+            driver: driver.map(|d| Box::new(d.continuation())),
         });
     }
 
@@ -140,28 +173,40 @@ mod tests {
     }
 
     /// Masing's rule on a hand-made history: a loop that closes is forgotten, a nested one
-    /// inside it first; past the first turning point or its mirror, only the start is left.
+    /// inside it first; at the mirror of the first turning point the first loading in the
+    /// other direction is reached; a repeated cycle remembers no more than its own turning
+    /// point.
     #[test]
     fn a_closed_loop_is_forgotten_and_an_open_one_remembered() {
-        // 0 → 5 → −5 → 3 → −2 → 4: the loop (3, −2) closes at 4 > 3.
-        assert_eq!(
-            walk(&[0.0, 5.0, -5.0, 3.0, -2.0, 4.0]),
-            vec![0.0, 5.0, -5.0]
-        );
+        // 0 → 5 → −5 (the first loading's mirror) → 3 → −2 → 4: (3, −2) closes at 4 > 3.
+        assert_eq!(walk(&[0.0, 5.0, -5.0, 3.0, -2.0, 4.0]), vec![0.0, -5.0]);
         // … → 2: still inside, (3, −2) remembered.
         assert_eq!(
             walk(&[0.0, 5.0, -5.0, 3.0, -2.0, 2.0]),
-            vec![0.0, 5.0, -5.0, 3.0, -2.0]
+            vec![0.0, -5.0, 3.0, -2.0]
         );
         // 0 → 5 → −5 → 3 → −2 → 1 → −1 → 4: (1, −1) then (3, −2) close.
         assert_eq!(
             walk(&[0.0, 5.0, -5.0, 3.0, -2.0, 1.0, -1.0, 4.0]),
-            vec![0.0, 5.0, -5.0]
+            vec![0.0, -5.0]
         );
-        // Past the first turning point: the first loading again, 0 → 5 → −5 → 6.
-        assert_eq!(walk(&[0.0, 5.0, -5.0, 6.0]), vec![0.0]);
-        // Past its mirror: 0 → 5 → −6.
+        // Past the mirror: 0 → 5 → −6, and 0 → 5 → −4 → 6.
         assert_eq!(walk(&[0.0, 5.0, -6.0]), vec![0.0]);
         assert_eq!(walk(&[0.0, 5.0, -4.0]), vec![0.0, 5.0]);
+        assert_eq!(walk(&[0.0, 5.0, -4.0, 6.0]), vec![0.0]);
+        // A loop inside: 0 → 5 → −4 → 2 → −3: (−4, 2) stays open.
+        assert_eq!(
+            walk(&[0.0, 5.0, -4.0, 2.0, -3.0]),
+            vec![0.0, 5.0, -4.0, 2.0]
+        );
+        // ±5 repeated 50 times.
+        let cycle: Vec<f64> = (0..101)
+            .map(|k| match k {
+                0 => 0.0,
+                k if k % 2 == 1 => 5.0,
+                _ => -5.0,
+            })
+            .collect();
+        assert!(walk(&cycle).len() <= 2, "{:?}", walk(&cycle));
     }
 }
