@@ -394,14 +394,7 @@ fn resumes(
     if !run.resume_due(last_of_phase) {
         return None;
     }
-    let options = SlipOptions {
-        step_evaluations: Some(
-            options
-                .step_evaluations
-                .map_or(TAKE_BACK_EVALUATIONS, |n| n.min(TAKE_BACK_EVALUATIONS)),
-        ),
-        ..options
-    };
+    let options = take_back_options(options);
     match try_step(model, disc, driver, point, options) {
         Ok(Tried::Slip(trial)) if agrees(run, last, &trial.record(driver)) => {
             let solved = driver.commit(*trial);
@@ -437,14 +430,7 @@ fn continues(
     if run.control != Control::Load || driver.phase_sign.is_none() {
         return None;
     }
-    let options = SlipOptions {
-        step_evaluations: Some(
-            options
-                .step_evaluations
-                .map_or(TAKE_BACK_EVALUATIONS, |n| n.min(TAKE_BACK_EVALUATIONS)),
-        ),
-        ..options
-    };
+    let options = take_back_options(options);
     let from = driver.state.tangential_load;
     let limit = model.friction * driver.state.normal_load;
     let longest = (point.q - before).abs().max(1e-3 * limit);
@@ -468,6 +454,18 @@ fn continues(
         finish_step(&mut driver, solved, increments, &mut NoObserver);
     }
     Some(driver)
+}
+
+/// `options` with a step's evaluations bounded by [`TAKE_BACK_EVALUATIONS`].
+fn take_back_options(options: SlipOptions) -> SlipOptions {
+    SlipOptions {
+        step_evaluations: Some(
+            options
+                .step_evaluations
+                .map_or(TAKE_BACK_EVALUATIONS, |n| n.min(TAKE_BACK_EVALUATIONS)),
+        ),
+        ..options
+    }
 }
 
 /// The most residual evaluations of a try to take the state back ([`resumes`]), in place of a
