@@ -5,13 +5,13 @@
 //! # The rule
 //! Within a phase, the state depends on the remembered turning states and Q only (the
 //! spectral solver's memory, and Mindlin–Deresiewicz for an uncoupled contact). A load that
-//! goes on past the last turning point of its own direction closes the loop between that
+//! reaches the last turning point of its own direction again closes the loop between that
 //! point and the turning point after it, and the contact forgets both (Masing's memory rule,
 //! the rainflow count of the load):
 //! ```text
 //! remembered  R₀ (the start), R₁, …, Rₙ        the phase under way began at Rₙ
 //! a step to Q in the direction d of the phase: while n ≥ 2 and d·Q ≥ d·Rₙ₋₁,
-//!             forget Rₙ₋₁ and Rₙ (n ← n − 2); at n = 1, past the mirror 2R₀ − R₁ of the
+//!             forget Rₙ₋₁ and Rₙ (n ← n − 2); at n = 1, at the mirror 2R₀ − R₁ of the
 //!             first turning point, forget R₁ (the first loading's state in the other
 //!             direction)
 //! ```
@@ -32,7 +32,8 @@ use serde::{Deserialize, Serialize};
 use super::driver::DriverState;
 
 /// Most driver states kept ([`Turnings::end_phase`]): a history whose amplitudes keep
-/// shrinking remembers every turning point, and a state is a few hundred kB.
+/// shrinking remembers every turning point, and each state holds a contact state and its
+/// memory.
 const KEPT_STATES: usize = 16;
 
 /// Whether a load going in direction `d` has reached `at` (a turning point reached again
