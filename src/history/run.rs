@@ -9,7 +9,7 @@ use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
 use crate::error::SolveFailure;
 
-use super::driver::{DriverState, SolvedStep, Tried, finish_step, hold_record, try_step};
+use super::driver::{DriverState, SolvedStep, Trial, Tried, finish_step, hold_record, try_step};
 use super::general::{GeneralRun, RunOptions, SolverChoice, SolverKind, ZoneCount};
 use super::increments::{IncrementInputs, StepIncrements};
 use super::load::{Control, LoadHistory, LoadPoint, PunchLoads};
@@ -397,12 +397,7 @@ fn resumes(
     let options = take_back_options(options);
     match try_step(model, disc, driver, point, options) {
         Ok(Tried::Slip(trial)) if agrees(run, last, &trial.record(driver)) => {
-            let solved = driver.commit(*trial);
-            let increments = solved.known_increments().unwrap_or_else(|| {
-                StepIncrements::compute(model, &solved.increment_inputs(driver))
-            });
-            finish_step(driver, solved, increments, &mut NoObserver);
-            Some(increments)
+            Some(commit_unobserved(model, driver, trial))
         }
         _ => {
             run.resume_failed();
@@ -447,13 +442,24 @@ fn continues(
         if k == parts && !agrees(run, general, &trial.record(&driver)) {
             return None;
         }
-        let solved = driver.commit(*trial);
-        let increments = solved
-            .known_increments()
-            .unwrap_or_else(|| StepIncrements::compute(model, &solved.increment_inputs(&driver)));
-        finish_step(&mut driver, solved, increments, &mut NoObserver);
+        commit_unobserved(model, &mut driver, trial);
     }
     Some(driver)
+}
+
+/// Commit `trial` to `driver` and finish the step with its increments, which no observer sees
+/// (a take-back: the general solver's record stands for the step); returns the increments.
+fn commit_unobserved(
+    model: &ContactModel,
+    driver: &mut DriverState,
+    trial: Box<Trial>,
+) -> StepIncrements {
+    let solved = driver.commit(*trial);
+    let increments = solved
+        .known_increments()
+        .unwrap_or_else(|| StepIncrements::compute(model, &solved.increment_inputs(driver)));
+    finish_step(driver, solved, increments, &mut NoObserver);
+    increments
 }
 
 /// `options` with a step's evaluations bounded by [`TAKE_BACK_EVALUATIONS`].
