@@ -152,7 +152,7 @@ impl NormalEnd {
             Self::Spectral(normal) => HistoryState::new(DriverState::after_normal_loading(normal)),
             Self::General(run, _) => HistoryState {
                 driver: None,
-                turnings: super::turnings::Turnings::new(run.state.loads.tangential),
+                turnings: super::turnings::Turnings::new(run.state.loads.tangential, None),
                 general: Some((**run).clone()),
             },
         }

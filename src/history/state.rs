@@ -104,7 +104,7 @@ impl HistoryState {
     /// The state at the start of a run from a driver.
     pub fn new(driver: DriverState) -> Self {
         Self {
-            turnings: Turnings::new(driver.state.tangential_load),
+            turnings: Turnings::new(driver.state.tangential_load, Some(&driver)),
             driver: Some(driver),
             general: None,
         }

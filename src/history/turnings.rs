@@ -23,6 +23,16 @@
 //! general solver's state of the step checks it. The rule is exact for an uncoupled contact
 //! (Mindlin–Deresiewicz); on a coupled one the contact moves with Q and the check decides.
 //!
+//! # Replay
+//! After the general solver has held the steps through turning points of its own, no kept
+//! state continues the phase under way. At a turning point the general solver took, with one
+//! stick zone (a state of the spectral form), the spectral solver rebuilds its state from the
+//! most recent kept one by stepping through the reduced history: the turning points
+//! remembered after it, then the load of the step. By the rule above that is the history the
+//! contact remembers; the general solver's state of the step checks it, as above (on a
+//! coupled contact a closed loop can leave a thin stick zone behind, which the spectral state
+//! does not have, and the check then refuses it).
+//!
 //! The loads alone decide what is remembered: as many turning points as the load's open
 //! nested loops (a handful in a random history, two in a repeated cycle), with the spectral
 //! driver's state at no more than [`KEPT_STATES`] of them.
@@ -59,14 +69,26 @@ pub struct Turnings {
     remembered: Vec<Turning>,
     /// The direction of the last change of the load (0 before the first).
     direction: f64,
+    /// Replays ([`Turnings::replay`]) that failed since the last that did not.
+    #[serde(default)]
+    replays_failed: u32,
+    /// Turning points to pass before the next replay.
+    #[serde(default)]
+    replay_wait: u32,
 }
 
 impl Turnings {
-    /// The start of a history at `load`.
-    pub fn new(load: f64) -> Self {
+    /// The start of a history at `load`, with the spectral driver's state there (the end of
+    /// the normal loading), from which the first loading in either direction goes on.
+    pub fn new(load: f64, driver: Option<&DriverState>) -> Self {
         Self {
-            remembered: vec![Turning { load, driver: None }],
+            remembered: vec![Turning {
+                load,
+                driver: driver.map(|d| Box::new(d.continuation())),
+            }],
             direction: 0.0,
+            replays_failed: 0,
+            replay_wait: 0,
         }
     }
 
@@ -104,9 +126,9 @@ impl Turnings {
                 )
             {
                 // Past the mirror of the first turning point: the first loading's in the
-                // other direction, which no turning state of the spectral solver continues.
+                // other direction, which goes on from the start.
                 self.remembered.pop();
-                continued = None;
+                continued = Some(self.remembered[0].driver.clone());
             } else {
                 break;
             }
@@ -149,6 +171,33 @@ impl Turnings {
         });
     }
 
+    /// The most recent turning point with a kept driver state, that state, and the loads of
+    /// the turning points remembered after it, oldest first: the reduced history from which
+    /// the spectral solver can rebuild its state (module docs, *Replay*). `None` when no state
+    /// is kept, or when the last replay failed fewer turning points ago than its wait (1, 3,
+    /// 7, … up to 31 after 1, 2, 3, … failures in a row, so that a history the spectral
+    /// solver cannot rebuild costs at most one replay in 32 turning points).
+    pub fn replay(&mut self) -> Option<(&DriverState, Vec<f64>)> {
+        if self.replay_wait > 0 {
+            self.replay_wait -= 1;
+            return None;
+        }
+        let j = self.remembered.iter().rposition(|t| t.driver.is_some())?;
+        let loads = self.remembered[j + 1..].iter().map(|t| t.load).collect();
+        let driver = self.remembered[j].driver.as_deref()?;
+        Some((driver, loads))
+    }
+
+    /// The outcome of the replay [`Turnings::replay`] gave.
+    pub fn replayed(&mut self, taken: bool) {
+        if taken {
+            self.replays_failed = 0;
+        } else {
+            self.replays_failed += 1;
+            self.replay_wait = (1u32 << self.replays_failed.min(5)) - 1;
+        }
+    }
+
     /// The loads remembered, oldest first.
     pub fn loads(&self) -> Vec<f64> {
         self.remembered.iter().map(|t| t.load).collect()
@@ -161,7 +210,7 @@ mod tests {
 
     /// Walk loads, ending a phase at each reversal, and return what is remembered.
     fn walk(loads: &[f64]) -> Vec<f64> {
-        let mut t = Turnings::new(loads[0]);
+        let mut t = Turnings::new(loads[0], None);
         for w in loads.windows(3) {
             t.step(w[0], w[1]);
             if (w[1] - w[0]) * (w[2] - w[1]) < 0.0 {

@@ -81,6 +81,25 @@ impl Solver {
         self.state_of_tractions(pressure, shear, charge, loads, shift)
     }
 
+    /// How far the tractions of a spectral state are from those of an element state on this
+    /// solver's mesh, as the L1 norms of the differences of the element means relative to
+    /// the load: `[Σ w|p̄ − p|/P, Σ w|q̄ − q|/(ηP)]`, p̄ and q̄ the spectral state's means,
+    /// P the element state's normal load. A memory that differs where the contact sticks shows
+    /// in q there, which the ends of the zones do not show.
+    pub fn traction_distance(&self, spectral: &ContactState, state: &GeneralState) -> [f64; 2] {
+        let [pressure, shear, _] = self.element_means(spectral, state.loads);
+        let load = state.loads.normal;
+        let l1 = |a: &[f64], b: &[f64]| -> f64 {
+            (0..a.len())
+                .map(|i| self.mesh.width(i) * (a[i] - b[i]).abs())
+                .sum()
+        };
+        [
+            l1(&pressure, &state.pressure) / load,
+            l1(&shear, &state.shear) / (self.coefficients.friction * load),
+        ]
+    }
+
     /// The element means of p, q and g of a spectral state (module docs).
     fn element_means(&self, state: &ContactState, loads: Loads) -> [Vec<f64>; 3] {
         let mesh = &self.mesh;
