@@ -102,6 +102,32 @@ fn a_closed_loop_is_taken_back_as_the_first_loading_continued() {
     assert!((c_over_a - exact).abs() < 1e-10, "{c_over_a} {exact}");
 }
 
+/// Past the mirror of the first turning point (0 → 0.5ηP by the spectral solver, down to
+/// −0.6ηP by the general solver) the contact is on the first loading in the other direction
+/// (Mindlin–Deresiewicz: unloading from Q* meets it at −Q*), which goes on from the start's
+/// state, the end of the normal loading: Cattaneo–Mindlin's `c/a = √(1 − |Q|/(ηP))`.
+#[test]
+fn past_the_mirror_of_the_first_turning_point_the_first_loading_goes_on_from_the_start() {
+    let sc = uncoupled();
+    let disc = Discretisation::new(sc.collocation_points);
+    let (model, options) = (&sc.model, SlipOptions::default());
+    let limit = model.friction * sc.normal_load;
+    let loads: Vec<f64> = (1..=22).map(|k| 0.5 - 0.05 * k as f64).collect();
+    let (_, run, (point, record)) = handed_over(&sc, &disc, &loads);
+    let start = crate::history::driver_after_normal_loading(&sc, &disc);
+    let before = (point, &record, -0.55 * limit);
+    let continued = continues(model, &disc, (start, &[]), &run, before, options)
+        .expect("the first loading goes on");
+    let c_over_a = stick_ratio(&continued);
+    let exact = (1.0 - 0.6_f64).sqrt();
+    println!(
+        "c/a {c_over_a:.8} against {exact:.8} ({:.1e})",
+        c_over_a - exact
+    );
+    assert_eq!(continued.phase, record.phase);
+    assert!((c_over_a - exact).abs() < 1e-10, "{c_over_a} {exact}");
+}
+
 /// `Solver::traction_distance` between two Cattaneo–Mindlin states of the first loading
 /// (uncoupled contact, Q1 = 0.5ηP and Q2 = 0.3ηP): q1 − q2 ≥ 0 everywhere, so the L1 norm
 /// of the difference is its integral, (Q1 − Q2)/(ηP) = 0.2, and p does not change.
@@ -124,7 +150,8 @@ fn the_shear_distance_of_two_cattaneo_mindlin_states_is_their_load_difference() 
 }
 
 /// The replay's turning points (`Turnings::replay`): from the start's state (the end of
-/// the normal loading) when no later one is kept; after 1, 2, 3, … failures in a row it
+/// the normal loading) when no later one is kept, which is also what a load past the mirror
+/// of the first turning point continues; after 1, 2, 3, … failures in a row it
 /// waits 1, 3, 7, … turning points, at most 31, and after one taken it does not wait.
 #[test]
 fn a_replay_starts_from_the_start_and_waits_longer_after_each_failure() {
@@ -150,6 +177,9 @@ fn a_replay_starts_from_the_start_and_waits_longer_after_each_failure() {
     assert_eq!(waits, [1, 3, 7, 15, 31, 31, 31]);
     turnings.replayed(true);
     assert!(turnings.replay().is_some());
+    // Past the mirror −1 of the first turning point: the start's state goes on.
+    let continued = turnings.step(-0.5, -1.5).expect("the start's state");
+    assert!(continued.phase_sign.is_none() && turnings.loads() == vec![0.0]);
 }
 
 /// Loaded to R1 = 0.5ηP by the spectral solver, then by the general solver down to
