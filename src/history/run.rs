@@ -497,8 +497,8 @@ fn continues(
 /// the element means' difference relative to ηP) at which a state rebuilt from a kept turning
 /// state ([`continues`]) is taken back. On the default contact's first 400 random reversals
 /// (`random.seed(7)`), the states that went on as the general solver's did were at 2.7e−4 to
-/// 1.5e−3, a replay whose stick zone held another memory (its ends within two elements, the
-/// next phase's stick end 0.21 a from the general solver's) at 0.11; on the uncoupled
+/// 1.5e−3, a replay whose stick zone held another memory (its ends within two elements; six
+/// phases later its stick end was 0.21 a from the general-only run's) at 0.11; on the uncoupled
 /// contact of the tests, exact, 4.6e−5 and 2.9e−4.
 ///
 /// [`Solver::traction_distance`]: crate::contact::general::Solver::traction_distance
