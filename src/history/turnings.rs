@@ -18,10 +18,12 @@
 //! After the loop closed, the phase under way is the phase that ended at `Rₙ₋₁` continued
 //! (the first loading, when that was R₁): the state at Q is the one that phase reaches at Q.
 //! When the spectral solver took the step that ended it, its driver state there (kept at every
-//! turning point) can take the state back by stepping on to Q, although the general solver
-//! held the steps of the loop (whose turning states the spectral memory cannot hold); the
-//! general solver's state of the step checks it. The rule is exact for an uncoupled contact
-//! (Mindlin–Deresiewicz); on a coupled one the contact moves with Q and the check decides.
+//! turning point; the start's, the end of the normal loading, too) can take the state back by
+//! stepping on to Q, although the general solver held the steps of the loop (whose turning
+//! states the spectral memory cannot hold); the general solver's state of the step checks it,
+//! in its zones and their ends and in its shear tractions. The rule is exact for an uncoupled
+//! contact (Mindlin–Deresiewicz); on a coupled one the contact moves with Q, a closed loop can
+//! leave memory behind, and the check decides.
 //!
 //! # Replay
 //! After the general solver has held the steps through turning points of its own, no kept
@@ -30,8 +32,9 @@
 //! most recent kept one by stepping through the reduced history: the turning points
 //! remembered after it, then the load of the step. By the rule above that is the history the
 //! contact remembers; the general solver's state of the step checks it, as above (on a
-//! coupled contact a closed loop can leave a thin stick zone behind, which the spectral state
-//! does not have, and the check then refuses it).
+//! coupled contact the loops left out can have left memory in the stick zone, a thin stick
+//! zone or another shear there, which the spectral state does not have, and the check then
+//! refuses it).
 //!
 //! The loads alone decide what is remembered: as many turning points as the load's open
 //! nested loops (a handful in a random history, two in a repeated cycle), with the spectral
