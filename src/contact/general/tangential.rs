@@ -236,15 +236,17 @@ fn primal_dual(
                 q[i] = t * p.w[i];
             }
         }
+        let is_free: Vec<bool> = status.iter().map(|&s| s == Bound::Free).collect();
         let (d, shift) = if free.is_empty() {
             (Vec::new(), 0.0)
         } else {
-            free_step(p, &free, &gradient(p, &q), work)?
+            free_step(p, &free, &gradient_on(p, &q, &is_free, true), work)?
         };
         for (k, &i) in free.iter().enumerate() {
             q[i] += d[k];
         }
-        let grad = gradient(p, &q);
+        // The slip of the bound elements (the free ones do not slip).
+        let grad = gradient_on(p, &q, &is_free, false);
         let slip: Vec<f64> = (0..n)
             .map(|i| match status[i] {
                 Bound::Free => 0.0,
@@ -384,6 +386,32 @@ fn shift_without_free(p: &Programme, grad: &[f64], status: &[Bound]) -> f64 {
         (false, true) => hi,
         (false, false) => 0.0,
     }
+}
+
+/// `(∇J)_i = (K q + c)_i` for the elements with `rows[i] == on` (0 for the others): by the
+/// symmetry of K each run of them is a block of its columns, transposed, times q.
+fn gradient_on(p: &Programme, q: &[f64], rows: &[bool], on: bool) -> Vec<f64> {
+    let n = q.len();
+    let mut grad = vec![0.0; n];
+    let mut start = 0;
+    while start < n {
+        if rows[start] != on {
+            start += 1;
+            continue;
+        }
+        let end = (start..n).find(|&i| rows[i] != on).unwrap_or(n);
+        grad[start..end].copy_from_slice(&p.c[start..end]);
+        faer::linalg::matmul::matmul(
+            ColMut::from_slice_mut(&mut grad[start..end]).as_mat_mut(),
+            Accum::Add,
+            p.l.subcols(start, end - start).transpose(),
+            ColRef::from_slice(q).as_mat(),
+            p.kernel.scale,
+            Par::Seq,
+        );
+        start = end;
+    }
+    grad
 }
 
 /// `∇J = K q + c`.
