@@ -85,9 +85,9 @@ pub struct RunOptions {
     /// Which solver takes the steps.
     pub solver: SolverChoice,
     /// Under [`SolverChoice::Auto`]: the general solver also takes the first step of every
-    /// phase, and the spectral solver's step is handed over when the two disagree
-    /// ([`super::continue_run`]).
-    pub check_phase_starts: bool,
+    /// phase and every turning point, and the spectral solver's step is handed over when the
+    /// two disagree ([`super::continue_run`]).
+    pub check_phases: bool,
     /// The general solver's largest element, relative to the contact half-width.
     pub general_element_size: f64,
     /// Keep every record in the run's records ([`super::HistoryRun::records`]), or only the
@@ -116,7 +116,7 @@ impl RunOptions {
         Self {
             slip,
             solver,
-            check_phase_starts: solver == SolverChoice::Auto,
+            check_phases: solver == SolverChoice::Auto,
             keep_records: true,
             general_element_size: INNER_SIZE,
         }
@@ -129,7 +129,7 @@ impl RunOptions {
         Self {
             slip,
             solver: SolverChoice::Spectral,
-            check_phase_starts: false,
+            check_phases: false,
             general_element_size: INNER_SIZE,
             keep_records: true,
         }
@@ -392,8 +392,21 @@ impl GeneralRun {
         inner: f64,
         recall: &mut Recall,
     ) -> Self {
+        Self::handover_onto(model, driver, &driver.state, inner, recall)
+    }
+
+    /// [`GeneralRun::handover`] on the mesh made for the spectral state `mesh_of` (the state
+    /// a step from the driver's leads to: the turning point's, whose mesh the check of the
+    /// next phase's first step uses again).
+    pub fn handover_onto(
+        model: &ContactModel,
+        driver: &DriverState,
+        mesh_of: &ContactState,
+        inner: f64,
+        recall: &mut Recall,
+    ) -> Self {
         let s = &driver.state;
-        let solver = recall.solver(model, mesh_for(s, inner), Options::default());
+        let solver = recall.solver(model, mesh_for(mesh_of, inner), Options::default());
         let loads = loads_of(model, s.normal_load, s.tangential_load);
         let state = if recall.enabled() {
             solver.adopt_rounded(s, loads, 0.0)

@@ -149,6 +149,68 @@ fn the_shear_distance_of_two_cattaneo_mindlin_states_is_their_load_difference() 
     );
 }
 
+/// The general solver's check of a turning point (`turning_checked`), uncoupled contact. The
+/// spectral solver's step from 0.45ηP to Q = 0.5ηP on the first loading agrees with it. The
+/// Mindlin–Deresiewicz state at the same load, unloaded from Q* = 0.7ηP (which the spectral
+/// solver holds exactly here), put forward as that step's state is contradicted and the step
+/// handed over: with ξ = x/a, c1² = 0.5, c'² = 1 − (Q* − Q)/(2ηP) = 0.9 and c*² = 0.3, the
+/// difference of the two shear tractions is
+/// `ηp0 [2√(1 − ξ²) − c1√(1 − ξ²/c1²) − 2c'√(1 − ξ²/c'²) + c*√(1 − ξ²/c*²)]` (each root
+/// taken as 0 outside its zone), and its L1 norm over ηP = ηp0πa/2 is computed here by the
+/// midpoint rule.
+#[test]
+fn a_turning_state_with_another_memory_is_handed_over_at_the_turning_point() {
+    let sc = uncoupled();
+    let disc = Discretisation::new(sc.collocation_points);
+    let (model, options) = (&sc.model, RunOptions::new(SolverChoice::Auto));
+    let limit = model.friction * sc.normal_load;
+    let before = first_loading(&sc, &disc, 9);
+    let point = at(10, 0.5 * limit);
+    let mut recall = Recall::new(false);
+    let first = first_loading(&sc, &disc, 10);
+    let agrees = turning_checked(model, &before, (point, options), &first.state, &mut recall);
+    assert!(agrees.is_none(), "the first loading was contradicted");
+    let mut unloaded = first_loading(&sc, &disc, 14);
+    for k in 1..=4 {
+        let point = at(14 + k, (0.7 - 0.05 * k as f64) * limit);
+        advance(
+            model,
+            &disc,
+            &mut unloaded,
+            point,
+            options.slip,
+            &mut NoObserver,
+        )
+        .unwrap();
+    }
+    let Some((failure, taken)) = turning_checked(
+        model,
+        &before,
+        (point, options),
+        &unloaded.state,
+        &mut recall,
+    ) else {
+        panic!("the unloaded state was not contradicted");
+    };
+    let [_, shear] = (taken.0.solver()).traction_distance(&unloaded.state, &taken.0.state);
+    let root = |xi: f64, c: f64| c * (1.0 - (xi / c).powi(2)).max(0.0).sqrt();
+    let (c1, c_half, c_star) = (0.5f64.sqrt(), 0.9f64.sqrt(), 0.3f64.sqrt());
+    let n = 200_000;
+    let exact = (0..n)
+        .map(|i| {
+            let xi = -1.0 + (i as f64 + 0.5) * 2.0 / n as f64;
+            (2.0 * root(xi, 1.0) - root(xi, c1) - 2.0 * root(xi, c_half) + root(xi, c_star)).abs()
+        })
+        .sum::<f64>()
+        * (2.0 / n as f64)
+        / (0.5 * std::f64::consts::PI);
+    println!("{}: {shear:.6} against {exact:.6}", failure.failure);
+    assert_eq!(taken.1.step, point.step);
+    // Measured: 0.195164 against 0.195108, the general solver's Cattaneo–Mindlin stick end
+    // within an element of the default mesh.
+    assert!((shear - exact).abs() < 1e-4, "{shear} {exact}");
+}
+
 /// The replay's turning points (`Turnings::replay`): from the start's state (the end of
 /// the normal loading) when no later one is kept, which is also what a load past the mirror
 /// of the first turning point continues; after 1, 2, 3, … failures in a row it
