@@ -39,6 +39,8 @@ struct Step {
     from: GeneralState,
     loads: Loads,
     drive: Drive,
+    /// The outer tolerance it was solved to.
+    tolerance: f64,
     result: (GeneralState, StepReport),
 }
 
@@ -125,13 +127,37 @@ impl Recall {
         loads: Loads,
         drive: Drive,
     ) -> Result<(GeneralState, StepReport), SolveFailure> {
+        self.step_to(solver, from, loads, drive, solver.options.tolerance)
+    }
+
+    /// `solver.step_to_tolerance(from, loads, tolerance)`, or the remembered result of the
+    /// same step to the same tolerance.
+    pub fn step_to_tolerance(
+        &mut self,
+        solver: &Arc<Solver>,
+        from: &GeneralState,
+        loads: Loads,
+        tolerance: f64,
+    ) -> Result<(GeneralState, StepReport), SolveFailure> {
+        self.step_to(solver, from, loads, Drive::Load, tolerance)
+    }
+
+    fn step_to(
+        &mut self,
+        solver: &Arc<Solver>,
+        from: &GeneralState,
+        loads: Loads,
+        drive: Drive,
+        tolerance: f64,
+    ) -> Result<(GeneralState, StepReport), SolveFailure> {
         if !self.enabled {
-            return solver.step_with(from, loads, drive);
+            return solver.step_to(from, loads, drive, tolerance);
         }
         let found = self.steps.iter().position(|s| {
             Arc::ptr_eq(&s.solver, solver)
                 && same_loads(s.loads, loads)
                 && same_drive(s.drive, drive)
+                && s.tolerance.to_bits() == tolerance.to_bits()
                 && same_state(&s.from, from)
         });
         if let Some(k) = found {
@@ -141,12 +167,13 @@ impl Recall {
             self.steps.push_front(step);
             return Ok(result);
         }
-        let result = solver.step_with(from, loads, drive)?;
+        let result = solver.step_to(from, loads, drive, tolerance)?;
         self.steps.push_front(Step {
             solver: Arc::clone(solver),
             from: from.clone(),
             loads,
             drive,
+            tolerance,
             result: result.clone(),
         });
         self.steps.truncate(STEPS);
