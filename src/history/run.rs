@@ -619,28 +619,19 @@ fn spectral_stretch(
             let before = driver.state.tangential_load;
             let tried = try_step(model, disc, driver, point, options.slip);
             finish(pending.take(), driver, records, observer);
-            if let (true, Ok(Tried::Slip(trial))) = (check, &tried)
-                && let Some((failure, mut taken)) = contradicted(
-                    model,
-                    driver,
-                    (point, options),
-                    &trial.record(driver),
-                    recall,
-                )
-            {
-                if k == 0 && after_take_back {
-                    taken.0.take_back_lost(driver.take_back_lost());
+            // The general solver's step where it contradicts the spectral solver's.
+            let mut contradiction = None;
+            if let Ok(Tried::Slip(trial)) = &tried {
+                if check {
+                    let record = trial.record(driver);
+                    contradiction = contradicted(model, driver, (point, options), &record, recall);
                 }
-                return Some(Stop {
-                    at: k,
-                    failure,
-                    taken: Some(taken),
-                });
+                if check_turning && contradiction.is_none() {
+                    let state = &trial.solved.state;
+                    contradiction = turning_checked(model, driver, (point, options), state, recall);
+                }
             }
-            if let (true, Ok(Tried::Slip(trial))) = (check_turning, &tried)
-                && let Some((failure, mut taken)) =
-                    turning_checked(model, driver, (point, options), &trial.solved.state, recall)
-            {
+            if let Some((failure, mut taken)) = contradiction {
                 if k == 0 && after_take_back {
                     taken.0.take_back_lost(driver.take_back_lost());
                 }
