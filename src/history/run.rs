@@ -781,14 +781,21 @@ fn contradicted(
     let mut run = GeneralRun::handover(model, before, options.general_element_size, recall);
     let general = run.step(model, point, recall).ok()?;
     let reason = disagreement(&run, &general, spectral)?;
-    let failure = StepFailure {
+    Some((
+        handover_reason(point, spectral.regime, reason),
+        (run, general),
+    ))
+}
+
+/// Why a check hands the spectral solver's step at `point` over to the general solver.
+fn handover_reason(point: LoadPoint, regime: Regime, reason: String) -> StepFailure {
+    StepFailure {
         step: point.step,
         t: point.t,
         q: point.q,
-        regime: spectral.regime,
-        failure: crate::error::SolveFailure::NoAdmissibleState { reason },
-    };
-    Some((failure, (run, general)))
+        regime,
+        failure: SolveFailure::NoAdmissibleState { reason },
+    }
 }
 
 /// The general solver's check of a turning point, which the spectral solver took from
@@ -797,9 +804,10 @@ fn contradicted(
 /// then finds in `recall`), and the two states' shear tractions must be within
 /// [`TURNING_SHEAR`] ([`Solver::traction_distance`]). When they are not, the reason to hand
 /// the step over and the general solver's run and record of it; `None` when they are or the
-/// general solver cannot take the step. The tractions, not the zone ends: a band at the friction limit holds `|q| = ηp` whether a
-/// solver counts it stuck or slipping (docs/validation.md), and the two solvers' stick ends
-/// there can be far apart with the same tractions.
+/// general solver cannot take the step. The tractions, not the zone ends: a band at the
+/// friction limit holds `|q| = ηp` whether a solver counts it stuck or slipping
+/// (docs/validation.md), and the two solvers' stick ends there can be far apart with the same
+/// tractions.
 ///
 /// [`Solver::traction_distance`]: crate::contact::general::Solver::traction_distance
 fn turning_checked(
@@ -827,20 +835,11 @@ fn turning_checked(
     if shear <= TURNING_SHEAR {
         return None;
     }
-    let failure = StepFailure {
-        step: point.step,
-        t: point.t,
-        q: point.q,
-        regime: record.regime,
-        failure: crate::error::SolveFailure::NoAdmissibleState {
-            reason: format!(
-                "at the turning point the general solver's shear tractions are {shear:.3e} of \
-                 ηP from the spectral solver's (L1 norm of the element means; at most \
-                 {TURNING_SHEAR:e})"
-            ),
-        },
-    };
-    Some((failure, (run, record)))
+    let reason = format!(
+        "at the turning point the general solver's shear tractions are {shear:.3e} of ηP from \
+         the spectral solver's (L1 norm of the element means; at most {TURNING_SHEAR:e})"
+    );
+    Some((handover_reason(point, record.regime, reason), (run, record)))
 }
 
 /// The largest distance of the shear tractions at which the general solver's check of a
