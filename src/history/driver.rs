@@ -148,7 +148,11 @@ pub fn advance(
     observer: &mut dyn Observer,
 ) -> Result<StepRecord, StepFailure> {
     Ok(match solve_step(model, disc, driver, point, options)? {
-        Solved::Hold(regime) => hold_record(driver, point, regime, observer),
+        Solved::Hold(regime) => {
+            let rec = hold_record(driver, point, regime);
+            observer.on_step(&rec, StateView::Spectral(&driver.state));
+            rec
+        }
         Solved::Slip(solved) => {
             let increments = solved.known_increments().unwrap_or_else(|| {
                 StepIncrements::compute(model, &solved.increment_inputs(driver))
@@ -192,27 +196,35 @@ impl SolvedStep {
     }
 }
 
-/// The record of a hold step (nothing changes), passed to the observer.
-pub(super) fn hold_record(
-    driver: &DriverState,
-    point: LoadPoint,
-    regime: Regime,
-    observer: &mut dyn Observer,
-) -> StepRecord {
+/// The record of a hold step (nothing changes; the observer's view of it is the driver's
+/// state).
+pub(super) fn hold_record(driver: &DriverState, point: LoadPoint, regime: Regime) -> StepRecord {
     let mut rec = record(point.step, point.t, driver, regime, None);
     rec.q = point.q;
-    observer.on_step(&rec, StateView::Spectral(&driver.state));
     rec
 }
 
 /// Commit a solved step's increments to the driver (δ, the anchor's ux, δn) and pass its
-/// record to the observer (after the phase it begins, if any). Steps must be finished in
-/// order.
+/// record to the observer (after the phase it begins, if any): [`settle_step`], then
+/// [`observe_step`]. Steps must be finished in order.
 pub fn finish_step(
     driver: &mut DriverState,
     solved: SolvedStep,
     increments: StepIncrements,
     observer: &mut dyn Observer,
+) -> StepRecord {
+    let rec = settle_step(driver, &solved, increments);
+    observe_step(observer, &rec, &solved);
+    rec
+}
+
+/// Commit a solved step's increments to the driver (δ, the anchor's ux, δn) and return its
+/// full record, which no observer has seen yet ([`observe_step`]). Steps must be settled in
+/// order.
+pub(super) fn settle_step(
+    driver: &mut DriverState,
+    solved: &SolvedStep,
+    increments: StepIncrements,
 ) -> StepRecord {
     if let Some(cell) = &solved.trace {
         // Set once: a step is finished once.
@@ -221,16 +233,20 @@ pub fn finish_step(
     driver.anchor_ux = Some((solved.inputs.anchor, increments.new_ux));
     driver.approach = Some(increments.new_approach);
     driver.displacement += increments.displacement;
-    let mut rec = solved.record;
+    let mut rec = solved.record.clone();
     rec.displacement = driver.displacement;
     rec.dissipation = increments.dissipation;
     rec.normal_work = increments.normal_work;
     rec.electric_work = increments.electric_work;
+    rec
+}
+
+/// Pass a settled step's record `rec` to the observer, after the phase it begins, if any.
+pub(super) fn observe_step(observer: &mut dyn Observer, rec: &StepRecord, solved: &SolvedStep) {
     if let Some((phase, memory)) = &solved.new_phase {
         observer.on_phase(*phase, memory);
     }
-    observer.on_step(&rec, StateView::Spectral(&solved.inputs.new));
-    rec
+    observer.on_step(rec, StateView::Spectral(&solved.inputs.new));
 }
 
 /// Solve one load step and commit its state to the driver (phase, memory, anchor, warm

@@ -3,20 +3,23 @@
 //! computed on a second thread; the run's result ([`HistoryRun`]) and failure
 //! ([`HistoryFailure`]).
 
-use crate::contact::general::{Loads, Recall};
+use crate::contact::ContactModel;
+use crate::contact::general::Recall;
 use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
-use crate::contact::{ContactModel, ContactState};
 use crate::error::SolveFailure;
 
-use super::driver::{DriverState, SolvedStep, Trial, Tried, finish_step, hold_record, try_step};
-use super::general::{GeneralRun, RunOptions, SolverChoice, SolverKind, ZoneCount};
+use super::checks::{Checks, Claim, Held, Outcome, Shown, Sink, StepState, disagreement};
+use super::driver::{
+    DriverState, SolvedStep, Trial, Tried, finish_step, hold_record, settle_step, try_step,
+};
+use super::general::{GeneralRun, RunOptions, SolverChoice, SolverKind};
 use super::increments::{IncrementInputs, StepIncrements};
 use super::load::{Control, LoadHistory, LoadPoint, PunchLoads};
 use super::normal::NormalEnd;
 use super::record::{NoObserver, Observer, StateView, StepFailure, StepRecord};
 use super::regime::{PhaseEvent, Regime, next_regime, phase_event};
-use super::state::{HistoryState, HistoryStateView};
+use super::state::HistoryState;
 use super::turnings::Turnings;
 
 /// A finished run: the records and the final state.
@@ -345,7 +348,7 @@ fn general_from_here(
 
 /// Add `record` to `records`: after every earlier one when `all`, in place of them otherwise
 /// ([`RunOptions::keep_records`]).
-fn keep(records: &mut Vec<StepRecord>, record: StepRecord, all: bool) {
+pub(super) fn keep(records: &mut Vec<StepRecord>, record: StepRecord, all: bool) {
     if !all {
         records.clear();
     }
@@ -502,7 +505,7 @@ fn continues(
 /// contact of the tests, exact, 4.6e−5 and 2.9e−4.
 ///
 /// [`Solver::traction_distance`]: crate::contact::general::Solver::traction_distance
-const TAKE_BACK_SHEAR: f64 = 5e-3;
+pub(super) const TAKE_BACK_SHEAR: f64 = 5e-3;
 
 /// Commit `trial` to `driver` and finish the step with its increments, which no observer sees
 /// (a take-back: the general solver's record stands for the step); returns the increments.
@@ -553,8 +556,13 @@ struct Stop {
 
 /// The spectral solver's steps from `driver` over `points`, pushing a record per step onto
 /// `records`; where it stopped, if it did (the driver is then at the last accepted step).
-/// Under `check_phases` the general solver takes the first step of each phase and each turning point as well,
-/// and the step stops the stretch when the two disagree ([`contradicted`]).
+/// Under `check_phases` the general solver checks the first step of each phase and each
+/// turning point as well, and the step stops the stretch when the two disagree
+/// ([`contradicted`], [`turning_checked`]); the checks run beside the steps that follow them
+/// (`super::checks`).
+///
+/// [`contradicted`]: super::checks::contradicted
+/// [`turning_checked`]: super::checks::turning_checked
 ///
 /// Pipelined on two threads: a step's increments (δ, dissipation, δn: a third of the work of
 /// a step) need only its two states, so they are computed on a worker thread while the next
@@ -573,6 +581,18 @@ fn spectral_stretch(
     (observer, recall): (&mut dyn Observer, &mut Recall),
     records: &mut Vec<StepRecord>,
 ) -> Option<Stop> {
+    // The stretch begins right after a take-back (`resumes`: the last record is the
+    // general solver's): a handover at its first step is a take-back lost.
+    let after_take_back = options.solver == SolverChoice::Auto
+        && records
+            .last()
+            .is_some_and(|r| r.solver == SolverKind::General);
+    let mut sink = Sink {
+        observer,
+        turnings,
+        records,
+        keep_records: options.keep_records,
+    };
     std::thread::scope(|scope| {
         let (jobs, inbox) = std::sync::mpsc::channel::<IncrementInputs>();
         let (outbox, results) = std::sync::mpsc::channel();
@@ -586,27 +606,57 @@ fn spectral_stretch(
                 }
             }
         });
-        let finish = |pending: Option<Box<SolvedStep>>,
+        // The step committed last, whose increments are still to come: its index, load before
+        // it and state.
+        let mut pending: Option<(usize, f64, Box<SolvedStep>)> = None;
+        let finish = |pending: Option<(usize, f64, Box<SolvedStep>)>,
                       driver: &mut DriverState,
-                      records: &mut Vec<StepRecord>,
-                      observer: &mut dyn Observer| {
-            if let Some(solved) = pending {
+                      held: &mut Held| {
+            if let Some((at, from, solved)) = pending {
                 let increments = solved.known_increments().unwrap_or_else(|| {
                     results
                         .recv()
                         .expect("the increments of a step do not panic")
                 });
-                let record = finish_step(driver, *solved, increments, observer);
-                keep(records, record, options.keep_records);
+                let record = settle_step(driver, &solved, increments);
+                let to = solved.inputs.new.tangential_load;
+                held.step((at, from, to), record, StepState::Slip(solved));
             }
         };
-        // The stretch begins right after a take-back (`resumes`: the last record is the
-        // general solver's): a handover at its first step is a take-back lost.
-        let after_take_back = options.solver == SolverChoice::Auto
-            && records
-                .last()
-                .is_some_and(|r| r.solver == SolverKind::General);
-        let mut pending: Option<Box<SolvedStep>> = None;
+        let mut checks = Checks::new(scope, model, options, recall);
+        let mut held = Held::default();
+        // What the checks' outcome leaves of the stretch: `None` to go on.
+        let settle = |outcome: Option<Outcome>,
+                      driver: &mut DriverState,
+                      held: &mut Held,
+                      sink: &mut Sink|
+         -> Option<Option<Stop>> {
+            // Agreed (or still running): the steps are shown as they are verified.
+            let Some(Outcome::Contradicted {
+                at,
+                handover,
+                before,
+            }) = outcome
+            else {
+                return None;
+            };
+            if let Shown::Stop = held.show(at, driver, sink) {
+                return Some(None);
+            }
+            held.drop_from(at);
+            if let Some(before) = before {
+                *driver = *before;
+            }
+            let (failure, mut taken) = *handover;
+            if at == 0 && after_take_back {
+                taken.0.take_back_lost(driver.take_back_lost());
+            }
+            Some(Some(Stop {
+                at,
+                failure,
+                taken: Some(taken),
+            }))
+        };
         for (k, &point) in points.iter().enumerate() {
             // The first step of a phase and every turning point are checked by the general
             // solver from the state before them (with the previous step finished: the general
@@ -614,50 +664,50 @@ fn spectral_stretch(
             let check = options.check_phases && begins_phase(model, driver, point);
             let check_turning = options.check_phases && turning[k];
             if check || check_turning {
-                finish(pending.take(), driver, records, observer);
+                finish(pending.take(), driver, &mut held);
             }
             let before = driver.state.tangential_load;
             let tried = try_step(model, disc, driver, point, options.slip);
-            finish(pending.take(), driver, records, observer);
-            // The general solver's step where it contradicts the spectral solver's.
-            let mut contradiction = None;
+            finish(pending.take(), driver, &mut held);
             if let Ok(Tried::Slip(trial)) = &tried {
                 if check {
-                    let record = trial.record(driver);
-                    contradiction = contradicted(model, driver, (point, options), &record, recall);
+                    let claim = Claim::PhaseStart(trial.record(driver));
+                    checks.start(k, driver, point, claim);
                 }
-                if check_turning && contradiction.is_none() {
-                    let state = &trial.solved.state;
-                    contradiction = turning_checked(model, driver, (point, options), state, recall);
+                if check_turning {
+                    let claim = Claim::Turning(trial.solved.state.clone());
+                    checks.start(k, driver, point, claim);
                 }
             }
-            if let Some((failure, mut taken)) = contradiction {
-                if k == 0 && after_take_back {
-                    taken.0.take_back_lost(driver.take_back_lost());
-                }
-                return Some(Stop {
-                    at: k,
-                    failure,
-                    taken: Some(taken),
-                });
+            if let Some(end) = settle(checks.resolve(false), driver, &mut held, &mut sink) {
+                return end;
             }
             match tried {
                 Ok(Tried::Hold(regime)) => {
-                    let record = hold_record(driver, point, regime, observer);
-                    keep(records, record, options.keep_records);
+                    let record = hold_record(driver, point, regime);
+                    let state = StepState::Hold(Box::new(driver.state.clone()));
+                    held.step((k, before, point.q), record, state);
                 }
                 Ok(Tried::Slip(trial)) => {
+                    checks.committing(k, driver);
                     let solved = Box::new(driver.commit(*trial));
                     if solved.known_increments().is_none() {
                         jobs.send(solved.increment_inputs(driver))
                             .expect("the increments worker runs until the steps end");
                     }
-                    pending = Some(solved);
+                    pending = Some((k, before, solved));
                 }
                 Err(failure) => {
+                    if let Some(end) = settle(checks.resolve(true), driver, &mut held, &mut sink) {
+                        return end;
+                    }
+                    if let Shown::Stop = held.show(usize::MAX, driver, &mut sink) {
+                        return None;
+                    }
                     let taken = (k == 0 && after_take_back)
                         .then(|| {
                             let lost_before = driver.take_back_lost();
+                            let recall = checks.recall();
                             take_back_lost(model, driver, (point, options, lost_before), recall)
                         })
                         .flatten();
@@ -668,23 +718,23 @@ fn spectral_stretch(
                     });
                 }
             }
-            turnings.step(before, point.q);
             if turning[k] {
-                finish(pending.take(), driver, records, observer);
-                turnings.end_phase(point.q, Some(driver));
-                let view = HistoryStateView {
-                    driver: Some(driver),
-                    general: None,
-                    turnings,
-                };
-                observer.on_checkpoint(records.last().expect("just pushed"), view);
-                if observer.stop() {
+                finish(pending.take(), driver, &mut held);
+                let below = checks.verified_below();
+                if let Shown::Stop = held.turning((k, point.q, below), driver, &mut sink) {
                     return None;
                 }
+            } else if let Shown::Stop = held.show(checks.verified_below(), driver, &mut sink) {
+                return None;
             }
         }
-        finish(pending.take(), driver, records, observer);
-        None
+        finish(pending.take(), driver, &mut held);
+        if let Some(end) = settle(checks.resolve(true), driver, &mut held, &mut sink) {
+            return end;
+        }
+        match held.show(usize::MAX, driver, &mut sink) {
+            Shown::Done | Shown::Stop => None,
+        }
     })
 }
 
@@ -711,150 +761,12 @@ fn agrees(run: &GeneralRun, general: &StepRecord, spectral: &StepRecord) -> bool
     disagreement(run, general, spectral).is_none()
 }
 
-/// Where the general solver's record of a step and the spectral solver's describe different
-/// states, if they do: another phase, another zone structure at the element resolution (a
-/// zone of one element is not a contradiction: [`ZoneCount::resolved`]), or a contact or
-/// stick end more than two elements of the general solver's mesh there from the other's.
-fn disagreement(run: &GeneralRun, general: &StepRecord, spectral: &StepRecord) -> Option<String> {
-    if spectral.phase != general.phase {
-        return Some(format!(
-            "the general solver's step is in phase {} where the spectral solver's is in phase {}",
-            general.phase, spectral.phase
-        ));
-    }
-    let resolved = ZoneCount::resolved(&run.state);
-    if spectral.zones != resolved {
-        return Some(format!(
-            "the general solver finds {} stick and {} slip zones ({} slip sign changes) where \
-             the spectral solver's state has {} and {} ({} slip sign changes)",
-            resolved.stick,
-            resolved.slip,
-            resolved.sign_changes,
-            spectral.zones.stick,
-            spectral.zones.slip,
-            spectral.zones.sign_changes
-        ));
-    }
-    let ends = |r: &StepRecord| {
-        let c = -r.eccentricity;
-        [c - r.half_width, c + r.half_width, r.stick_lo, r.stick_hi]
-    };
-    let names = [
-        "left contact end",
-        "right contact end",
-        "left stick end",
-        "right stick end",
-    ];
-    ends(general)
-        .into_iter()
-        .zip(ends(spectral))
-        .zip(names)
-        .map(|((g, s), name)| (name, g, s, (g - s).abs() / run.state.mesh.width_at(g)))
-        .filter(|&(.., elements)| elements > 2.0)
-        .max_by(|x, y| x.3.total_cmp(&y.3))
-        .map(|(name, g, s, elements)| {
-            format!(
-                "the general solver's {name} is at {g:.6e} m, the spectral solver's at \
-                 {s:.6e} m ({elements:.1} elements apart; the same zones)"
-            )
-        })
-}
-
 /// Whether the step at `point` begins a phase from the driver's state.
 fn begins_phase(model: &ContactModel, driver: &DriverState, point: LoadPoint) -> bool {
     let limit = model.friction * driver.state.normal_load;
     let regime = next_regime(point.q - driver.state.tangential_load, 1e-12 * limit);
     matches!(phase_event(driver.phase_sign, regime), PhaseEvent::Begin(_))
 }
-
-/// The general solver's check of the first step of a phase, which the spectral solver took
-/// from `before` with the record `spectral`: when the general solver finds another state (end
-/// layers the spectral form cannot hold), the reason to hand the step over and the general
-/// solver's run and record of it; `None` when it agrees or cannot take the step itself.
-fn contradicted(
-    model: &ContactModel,
-    before: &DriverState,
-    (point, options): (LoadPoint, RunOptions),
-    spectral: &StepRecord,
-    recall: &mut Recall,
-) -> Option<(StepFailure, (GeneralRun, StepRecord))> {
-    let mut run = GeneralRun::handover(model, before, options.general_element_size, recall);
-    let general = run.step(model, point, recall).ok()?;
-    let reason = disagreement(&run, &general, spectral)?;
-    Some((
-        handover_reason(point, spectral.regime, reason),
-        (run, general),
-    ))
-}
-
-/// Why a check hands the spectral solver's step at `point` over to the general solver.
-fn handover_reason(point: LoadPoint, regime: Regime, reason: String) -> StepFailure {
-    StepFailure {
-        step: point.step,
-        t: point.t,
-        q: point.q,
-        regime,
-        failure: SolveFailure::NoAdmissibleState { reason },
-    }
-}
-
-/// The general solver's check of a turning point, which the spectral solver took from
-/// `before` to the state `spectral`: the general solver takes the same step, handed over from
-/// `before` onto the mesh made for `spectral` (which the check of the next phase's first step
-/// then finds in `recall`), and the two states' shear tractions must be within
-/// [`TURNING_SHEAR`] ([`Solver::traction_distance`]). When they are not, the reason to hand
-/// the step over and the general solver's run and record of it; `None` when they are or the
-/// general solver cannot take the step. The tractions, not the zone ends: a band at the
-/// friction limit holds `|q| = ηp` whether a solver counts it stuck or slipping
-/// (docs/validation.md), and the two solvers' stick ends there can be far apart with the same
-/// tractions.
-///
-/// [`Solver::traction_distance`]: crate::contact::general::Solver::traction_distance
-fn turning_checked(
-    model: &ContactModel,
-    before: &DriverState,
-    (point, options): (LoadPoint, RunOptions),
-    spectral: &ContactState,
-    recall: &mut Recall,
-) -> Option<(StepFailure, (GeneralRun, StepRecord))> {
-    let size = options.general_element_size;
-    let mut run = GeneralRun::handover_onto(model, before, spectral, size, recall);
-    // The check to a tolerance its bound allows; a step it contradicts, to the solver's own.
-    let loads = Loads {
-        tangential: point.q,
-        ..run.state.loads
-    };
-    let (checked, _) = recall
-        .step_to_tolerance(run.solver(), &run.state, loads, CHECK_TOLERANCE)
-        .ok()?;
-    if run.solver().traction_distance(spectral, &checked)[1] <= TURNING_SHEAR {
-        return None;
-    }
-    let record = run.step(model, point, recall).ok()?;
-    let [_, shear] = run.solver().traction_distance(spectral, &run.state);
-    if shear <= TURNING_SHEAR {
-        return None;
-    }
-    let reason = format!(
-        "at the turning point the general solver's shear tractions are {shear:.3e} of ηP from \
-         the spectral solver's (L1 norm of the element means; at most {TURNING_SHEAR:e})"
-    );
-    Some((handover_reason(point, record.regime, reason), (run, record)))
-}
-
-/// The largest distance of the shear tractions at which the general solver's check of a
-/// turning point agrees with the spectral solver's state ([`turning_checked`]). Measured on
-/// turning states the spectral solver got right: the default history's seven at 7.9e−5 to
-/// 1.2e−4; the default contact's first 400 random reversals (`random.seed(7)`), 216 at
-/// 8.3e−5 to 8.0e−3, the largest where the stick zone remembers several earlier ones. A state
-/// with another memory at the same load: 0.195 (the test of [`turning_checked`]); the replays
-/// refused by [`TAKE_BACK_SHEAR`], 0.034 to 0.11.
-const TURNING_SHEAR: f64 = 1e-2;
-
-/// The outer tolerance of the general solver's step in the check of a turning point
-/// ([`turning_checked`]): the step's tractions are then within about 2e−5 of ηp of the
-/// converged ones, far inside [`TURNING_SHEAR`].
-const CHECK_TOLERANCE: f64 = 1e-4;
 
 #[cfg(test)]
 mod tests;

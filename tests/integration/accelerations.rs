@@ -148,6 +148,7 @@ fn the_default_options_are_the_fast_path() {
             || none.projected_updates
             || none.chain_tables
             || none.continuation
-            || none.general_recall)
+            || none.general_recall
+            || none.concurrent_checks)
     );
 }

@@ -280,3 +280,105 @@ fn above_gamma1_the_elements_that_overlap_the_punch_enter_from_the_step_start() 
             .all(|r| r.solver == SolverKind::Spectral)
     );
 }
+
+/// Every call a run makes of its observer, written out to the bit (`{:?}` of the records and
+/// of the states, the checkpoints' states as they are written), and an end asked for at the
+/// `stop_at`-th checkpoint.
+struct Calls {
+    seen: Vec<String>,
+    checkpoints: usize,
+    stop_at: usize,
+}
+
+impl Calls {
+    fn new(stop_at: usize) -> Self {
+        Self {
+            seen: Vec::new(),
+            checkpoints: 0,
+            stop_at,
+        }
+    }
+}
+
+impl fretsim::history::Observer for Calls {
+    fn on_step(&mut self, record: &StepRecord, state: fretsim::history::StateView<'_>) {
+        let state = match state {
+            fretsim::history::StateView::Spectral(s) => format!("{s:?}"),
+            fretsim::history::StateView::General(_, s) => format!("{s:?}"),
+        };
+        self.seen.push(format!("step {record:?} {state}"));
+    }
+    fn on_handover(&mut self, failure: &fretsim::history::StepFailure) {
+        self.seen
+            .push(format!("handover {failure}: {:?}", failure.failure));
+    }
+    fn on_phase(&mut self, phase: usize, memory: &fretsim::contact::memory::Memory) {
+        self.seen.push(format!("phase {phase} {memory:?}"));
+    }
+    fn on_checkpoint(&mut self, last: &StepRecord, state: fretsim::history::HistoryStateView<'_>) {
+        self.checkpoints += 1;
+        let written = serde_json::to_string(&state).expect("a state is written");
+        self.seen
+            .push(format!("checkpoint {} {written}", last.step));
+    }
+    fn stop(&self) -> bool {
+        self.checkpoints >= self.stop_at
+    }
+}
+
+/// The default scenario's history under `auto`, with the general solver's checks run beside
+/// the steps or in turn (`Accelerations::concurrent_checks`), ended at the `stop_at`-th
+/// checkpoint: what the observer saw, the records and the state written at the end.
+fn default_history_checked(concurrent: bool, stop_at: usize) -> (Vec<String>, usize, String) {
+    use fretsim::contact::normal::{NormalOptions, solve_normal};
+    use fretsim::contact::pressure::Discretisation;
+    let sc = fretsim::scenario::default_scenario();
+    let disc = Discretisation::new(sc.collocation_points);
+    let normal = fretsim::history::NormalEnd::Spectral(Box::new(
+        solve_normal(&sc.model, &disc, sc.normal_load, NormalOptions::default()).unwrap(),
+    ));
+    let mut options = fretsim::history::RunOptions::new(sc.solver);
+    options.slip.accelerations.concurrent_checks = concurrent;
+    let history = sc.history.as_ref().expect("a history");
+    let mut calls = Calls::new(stop_at);
+    let run =
+        fretsim::history::run_history(&sc.model, &disc, &normal, history, options, &mut calls)
+            .expect("the default history completes");
+    let state = serde_json::to_string(&run.state).expect("a state is written");
+    (calls.seen, run.records.len(), state)
+}
+
+/// The general solver's checks run beside the spectral solver's steps give the run of the
+/// checks taken in turn, to the bit: every call of the observer (records, states, phases,
+/// handovers, the checkpoints' states) and the final state. The default history exercises
+/// every path: its turning points' checks agree (their checkpoints wait for them), the first
+/// loading's first step is confirmed, and the first step of every later phase is contradicted
+/// (end layers) after the spectral solver has gone on past it, so the run is taken back to
+/// the turning state. Ended by the observer at the second turning point (whose checkpoint
+/// waits for its check while later steps are tried), the state is that turning point's.
+#[test]
+fn checks_beside_the_steps_give_the_run_of_checks_in_turn() {
+    for stop_at in [usize::MAX, 2] {
+        let (beside, beside_records, beside_state) = default_history_checked(true, stop_at);
+        let (in_turn, records, state) = default_history_checked(false, stop_at);
+        let handovers = in_turn.iter().filter(|c| c.starts_with("handover")).count();
+        let checkpoints = in_turn
+            .iter()
+            .filter(|c| c.starts_with("checkpoint"))
+            .count();
+        println!(
+            "stop at {stop_at}: {} calls, {handovers} handovers, {checkpoints} checkpoints, {records} records",
+            in_turn.len()
+        );
+        assert!(handovers > 0, "no check contradicted");
+        assert_eq!(beside.len(), in_turn.len());
+        for (k, (x, y)) in beside.iter().zip(&in_turn).enumerate() {
+            assert!(x == y, "call {k} differs");
+        }
+        assert_eq!(beside_records, records);
+        assert!(beside_state == state, "the final states differ");
+        if stop_at == 2 {
+            assert_eq!(checkpoints, 2);
+        }
+    }
+}

@@ -59,6 +59,13 @@ pub struct Accelerations {
     /// phase of a steady cycle). Bit-identical: a step is a pure function of its solver, its
     /// state and its loads.
     pub general_recall: bool,
+    /// Under `numerics.solver = auto`, run the general solver's checks of the spectral
+    /// solver's steps (the first step of each phase, each turning point) on a thread of their
+    /// own while the spectral solver takes the steps after them; what the observer sees of a
+    /// step waits until every check before it has agreed, and a check that contradicts takes
+    /// the run back to the state before its step (`history::checks`). The records and what the
+    /// observer sees are the same as with the checks run in turn, to the bit.
+    pub concurrent_checks: bool,
 }
 
 impl Default for Accelerations {
@@ -72,6 +79,7 @@ impl Default for Accelerations {
             chain_tables: true,
             continuation: true,
             general_recall: true,
+            concurrent_checks: true,
         }
     }
 }
@@ -87,6 +95,7 @@ impl Accelerations {
             chain_tables: false,
             continuation: false,
             general_recall: false,
+            concurrent_checks: false,
         }
     }
 

@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::contact::general::Recall;
+use crate::history::checks::turning_checked;
 use crate::history::driver::advance;
 use crate::history::general::INNER_SIZE;
 
