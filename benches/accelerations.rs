@@ -72,7 +72,7 @@ type SwitchOff = fn(&mut Accelerations);
 /// Every speed-up on, each one off, and all off.
 fn variants() -> Vec<(String, Accelerations)> {
     let on = Accelerations::default();
-    let off: [(&str, SwitchOff); 7] = [
+    let off: [(&str, SwitchOff); 8] = [
         ("recall", |a| a.recall = false),
         ("coarse_jacobian", |a| a.coarse_jacobian = false),
         ("mixed_start_guesses", |a| a.mixed_start_guesses = false),
@@ -80,6 +80,7 @@ fn variants() -> Vec<(String, Accelerations)> {
         ("chain_tables", |a| a.chain_tables = false),
         ("continuation", |a| a.continuation = false),
         ("general_recall", |a| a.general_recall = false),
+        ("concurrent_checks", |a| a.concurrent_checks = false),
     ];
     let mut all = vec![("all on".to_string(), on)];
     for (name, switch_off) in off {
