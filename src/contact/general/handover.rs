@@ -100,16 +100,17 @@ impl Solver {
         ]
     }
 
-    /// The element means of p, q and g of a spectral state (module docs).
+    /// The element means of p, q and g of a spectral state (module docs): the rule's points
+    /// of every element in contact evaluated in one batch ([`ContactState::pressures_into`],
+    /// bit-identical to the state's values point by point), then summed element by element.
     fn element_means(&self, state: &ContactState, loads: Loads) -> [Vec<f64>; 3] {
         let mesh = &self.mesh;
         let n = mesh.len();
         let (c, a) = (state.centre, state.half_width);
         let (nodes, weights) = gauss_legendre(POINTS);
         let conducting = !matches!(self.electric_control(loads), super::ElectricControl::None);
-        let mut pressure = vec![0.0; n];
-        let mut shear = vec![0.0; n];
-        let mut charge = vec![0.0; n];
+        // The points and weights dx of each element in contact, in order.
+        let (mut xs, mut dxs, mut elements) = (Vec::new(), Vec::new(), Vec::new());
         for i in 0..n {
             let (x1, x2) = (mesh.edges[i].max(c - a), mesh.edges[i + 1].min(c + a));
             if x2 <= x1 {
@@ -119,15 +120,30 @@ impl Solver {
             let angle = |x: f64| ((c - x) / a).clamp(-1.0, 1.0).acos();
             let (t1, t2) = (angle(x1), angle(x2));
             let (mid, half) = (0.5 * (t1 + t2), 0.5 * (t2 - t1));
-            let (mut sp, mut sq, mut sg) = (0.0, 0.0, 0.0);
+            elements.push(i);
             for (v, w) in nodes.iter().zip(&weights) {
                 let t = mid + half * v;
-                let x = c - a * t.cos();
-                let dx = w * half * a * t.sin();
-                sp += state.pressure_at(x) * dx;
-                sq += state.traction_at(x) * dx;
+                xs.push(c - a * t.cos());
+                dxs.push(w * half * a * t.sin());
+            }
+        }
+        let (mut p, mut q, mut w) = (Vec::new(), Vec::new(), Vec::new());
+        state.pressures_into(&xs, &mut p);
+        state.tractions_with(&xs, &p, &mut q);
+        if conducting {
+            state.potential_charges_into(&xs, &mut w);
+        }
+        let mut pressure = vec![0.0; n];
+        let mut shear = vec![0.0; n];
+        let mut charge = vec![0.0; n];
+        for (e, &i) in elements.iter().enumerate() {
+            let (mut sp, mut sq, mut sg) = (0.0, 0.0, 0.0);
+            for k in e * POINTS..(e + 1) * POINTS {
+                sp += p[k] * dxs[k];
+                sq += q[k] * dxs[k];
                 if conducting {
-                    sg += state.charge_at(x) * dx;
+                    // g = χp + w ([`ContactState::charge_at`]).
+                    sg += (state.split.ratio * p[k] + w[k]) * dxs[k];
                 }
             }
             let width = mesh.width(i);
