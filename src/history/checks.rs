@@ -11,7 +11,8 @@
 //! another in the order of their steps (each takes the general solver's recall from the one
 //! before it), while the spectral solver takes the next steps on the run's thread. What the
 //! observer sees of a step, the turning points' checkpoints and the run's records wait
-//! ([`Held`]) until every check up to that step has agreed. A check that contradicts takes
+//! ([`Held`]) until every check up to that step has agreed (each check sends its verdict as
+//! it ends). A check that contradicts takes
 //! the driver back to the state before its step (a copy kept when the step was committed)
 //! and the steps after it are dropped, as if they had never been tried: the records, the
 //! turning states and every call of the observer are those of the checks run in turn (test
@@ -21,6 +22,7 @@
 //! [`Accelerations::concurrent_checks`]: crate::contact::tangential::Accelerations::concurrent_checks
 
 use std::collections::VecDeque;
+use std::sync::mpsc::{Receiver, Sender};
 use std::thread::{Scope, ScopedJoinHandle};
 
 use crate::contact::general::{Loads, Recall};
@@ -71,40 +73,43 @@ impl Job {
     }
 }
 
-/// The checks' verdict so far: the first contradiction (its step's index and the handover),
-/// with the recall back.
-type Verdict<'r> = (Option<(usize, Box<Handover>)>, &'r mut Recall);
+/// The end of the checks started so far: whether one contradicted (the later ones are then
+/// not run), and the recall.
+type ChainEnd<'r> = (bool, &'r mut Recall);
 
-/// The checks started and not yet resolved: the verdict, or the thread that works it out.
+/// The checks started: the end of the last one, or the thread that runs it (after the
+/// earlier ones).
 enum Chain<'scope, 'r> {
-    Ready(Verdict<'r>),
-    Running(ScopedJoinHandle<'scope, Verdict<'r>>),
+    Ready(ChainEnd<'r>),
+    Running(ScopedJoinHandle<'scope, ChainEnd<'r>>),
 }
 
 impl<'r> Chain<'_, 'r> {
-    fn verdict(self) -> Verdict<'r> {
+    fn end(self) -> ChainEnd<'r> {
         match self {
-            Self::Ready(verdict) => verdict,
+            Self::Ready(end) => end,
             Self::Running(thread) => thread.join().expect("a check does not panic"),
         }
     }
 }
 
-/// How the checks resolved.
-pub(super) enum Outcome {
-    /// Every check started so far agreed.
-    Agreed,
-    /// The check of the step at index `at` contradicted it: the handover, and the driver
-    /// before that step when the step was committed since (else the driver is still there).
-    Contradicted {
-        at: usize,
-        handover: Box<Handover>,
-        before: Option<Box<DriverState>>,
-    },
+/// A check's verdict, as each check sends it when it is done: its step's index, and the
+/// handover if it contradicts.
+type Verdict = (usize, Option<Box<Handover>>);
+
+/// A check that contradicted its step at index `at` (the first in step order that did): the
+/// handover, and the driver before that step when the step was committed since (else the
+/// driver is still there).
+pub(super) struct Contradiction {
+    pub(super) at: usize,
+    pub(super) handover: Box<Handover>,
+    pub(super) before: Option<Box<DriverState>>,
 }
 
 /// The general solver's checks of a spectral stretch, in the order of their steps, on a
-/// thread of their own or in turn ([`Accelerations::concurrent_checks`]).
+/// thread of their own or in turn ([`Accelerations::concurrent_checks`]). Each sends its
+/// verdict when it is done, so that the steps before the next open check are verified as
+/// soon as the checks before them agree.
 ///
 /// [`Accelerations::concurrent_checks`]: crate::contact::tangential::Accelerations::concurrent_checks
 pub(super) struct Checks<'scope, 'env, 'r> {
@@ -112,9 +117,10 @@ pub(super) struct Checks<'scope, 'env, 'r> {
     model: &'env ContactModel,
     options: RunOptions,
     chain: Option<Chain<'scope, 'r>>,
+    verdicts: (Sender<Verdict>, Receiver<Verdict>),
     /// The steps whose checks are not resolved, in order, each with the driver before it
     /// once the step is committed.
-    open: Vec<(usize, Option<Box<DriverState>>)>,
+    open: VecDeque<(usize, Option<Box<DriverState>>)>,
 }
 
 impl<'scope, 'env: 'scope, 'r: 'scope> Checks<'scope, 'env, 'r> {
@@ -128,8 +134,9 @@ impl<'scope, 'env: 'scope, 'r: 'scope> Checks<'scope, 'env, 'r> {
             scope,
             model,
             options,
-            chain: Some(Chain::Ready((None, recall))),
-            open: Vec::new(),
+            chain: Some(Chain::Ready((false, recall))),
+            verdicts: std::sync::mpsc::channel(),
+            open: VecDeque::new(),
         }
     }
 
@@ -150,20 +157,24 @@ impl<'scope, 'env: 'scope, 'r: 'scope> Checks<'scope, 'env, 'r> {
         };
         let (model, options) = (self.model, self.options);
         let earlier = self.chain.take().expect("the chain is put back");
+        let verdicts = self.verdicts.0.clone();
         let check = move || {
-            let (found, recall) = earlier.verdict();
-            if found.is_some() {
-                return (found, recall);
+            let (contradicted, recall) = earlier.end();
+            if contradicted {
+                return (true, recall);
             }
-            let handover = job.run(model, options, recall);
-            (handover.map(|h| (job.at, Box::new(h))), recall)
+            let handover = job.run(model, options, recall).map(Box::new);
+            let found = handover.is_some();
+            // The receiver lives as long as the stretch, which joins every check.
+            let _ = verdicts.send((job.at, handover));
+            (found, recall)
         };
         self.chain = Some(if options.slip.accelerations.concurrent_checks {
             Chain::Running(self.scope.spawn(check))
         } else {
             Chain::Ready(check())
         });
-        self.open.push((at, None));
+        self.open.push_back((at, None));
     }
 
     /// Before the step at index `at` is committed to `driver`: keep the driver's state for
@@ -176,43 +187,43 @@ impl<'scope, 'env: 'scope, 'r: 'scope> Checks<'scope, 'env, 'r> {
 
     /// The index of the first step whose check is open: every step before it is verified.
     pub(super) fn verified_below(&self) -> usize {
-        self.open.first().map_or(usize::MAX, |&(k, _)| k)
+        self.open.front().map_or(usize::MAX, |&(k, _)| k)
     }
 
-    /// The outcome of the open checks once they are all done (waiting for them when `wait`);
-    /// `None` while some still run, or when none is open.
-    pub(super) fn resolve(&mut self, wait: bool) -> Option<Outcome> {
-        if self.open.is_empty() {
-            return None;
+    /// The verdicts of the checks done so far, in order (waiting for every open one when
+    /// `wait`): the checks that agreed are resolved, and the first contradiction is
+    /// returned (the checks after it are dropped).
+    pub(super) fn resolve(&mut self, wait: bool) -> Option<Contradiction> {
+        while !self.open.is_empty() {
+            let verdict = if wait {
+                self.verdicts.1.recv().ok()
+            } else {
+                self.verdicts.1.try_recv().ok()
+            };
+            let Some((at, handover)) = verdict else {
+                break;
+            };
+            let (open, before) = self.open.pop_front().expect("an open check");
+            debug_assert_eq!(open, at, "verdicts come in the order of their steps");
+            if let Some(handover) = handover {
+                self.open.clear();
+                return Some(Contradiction {
+                    at,
+                    handover,
+                    before,
+                });
+            }
         }
-        if let Some(Chain::Running(thread)) = &self.chain
-            && !wait
-            && !thread.is_finished()
-        {
-            return None;
-        }
-        let (found, recall) = self.chain.take().expect("the chain is put back").verdict();
-        self.chain = Some(Chain::Ready((None, recall)));
-        let open = std::mem::take(&mut self.open);
-        Some(match found {
-            None => Outcome::Agreed,
-            Some((at, handover)) => Outcome::Contradicted {
-                at,
-                handover,
-                before: open
-                    .into_iter()
-                    .find(|(k, _)| *k == at)
-                    .and_then(|(_, d)| d),
-            },
-        })
+        None
     }
 
-    /// The general solver's recall, once every check is resolved.
+    /// The general solver's recall, once every check has ended.
     pub(super) fn recall(&mut self) -> &mut Recall {
-        assert!(self.open.is_empty(), "the checks are resolved first");
+        let end = self.chain.take().expect("the chain is put back").end();
+        self.chain = Some(Chain::Ready(end));
         match self.chain.as_mut() {
             Some(Chain::Ready((_, recall))) => recall,
-            _ => unreachable!("a resolved chain is ready"),
+            _ => unreachable!("set above"),
         }
     }
 }

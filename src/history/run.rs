@@ -9,7 +9,7 @@ use crate::contact::pressure::Discretisation;
 use crate::contact::tangential::SlipOptions;
 use crate::error::SolveFailure;
 
-use super::checks::{Checks, Claim, Held, Outcome, Shown, Sink, StepState, disagreement};
+use super::checks::{Checks, Claim, Contradiction, Held, Shown, Sink, StepState, disagreement};
 use super::driver::{
     DriverState, SolvedStep, Trial, Tried, finish_step, hold_record, settle_step, try_step,
 };
@@ -626,20 +626,17 @@ fn spectral_stretch(
         let mut checks = Checks::new(scope, model, options, recall);
         let mut held = Held::default();
         // What the checks' outcome leaves of the stretch: `None` to go on.
-        let settle = |outcome: Option<Outcome>,
+        let settle = |found: Option<Contradiction>,
                       driver: &mut DriverState,
                       held: &mut Held,
                       sink: &mut Sink|
          -> Option<Option<Stop>> {
-            // Agreed (or still running): the steps are shown as they are verified.
-            let Some(Outcome::Contradicted {
+            // None contradicted (yet): the steps are shown as they are verified.
+            let Contradiction {
                 at,
                 handover,
                 before,
-            }) = outcome
-            else {
-                return None;
-            };
+            } = found?;
             if let Shown::Stop = held.show(at, driver, sink) {
                 return Some(None);
             }
