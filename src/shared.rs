@@ -202,3 +202,17 @@ pub mod extended {
         }
     }
 }
+
+/// Give the memory this thread's allocator keeps for reuse back to the system, where the
+/// allocator is the command's (mimalloc, feature `mimalloc`): for a worker thread about to
+/// end, whose pages mimalloc would otherwise leave to be reclaimed by other threads later (on
+/// the default contact's steady cycles, a check thread per stretch without this: 125 MB peak
+/// over 10,000 cycles).
+pub(crate) fn release_thread_memory() {
+    #[cfg(feature = "mimalloc")]
+    // SAFETY: `mi_collect` only returns this thread's free pages to the system; it is sound
+    // to call from any thread at any time.
+    unsafe {
+        libmimalloc_sys::mi_collect(true)
+    };
+}

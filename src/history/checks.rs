@@ -7,12 +7,14 @@
 //! # Beside the steps
 //! A check needs the state before its step, the step's load and what the spectral solver made
 //! of the step; the steps after it need nothing from the check unless it contradicts. With
-//! [`Accelerations::concurrent_checks`] the checks run on a thread of their own, one after
-//! another in the order of their steps (each takes the general solver's recall from the one
-//! before it), while the spectral solver takes the next steps on the run's thread. What the
+//! [`Accelerations::concurrent_checks`] the checks run on a thread of their own (one for a
+//! stretch of spectral steps, which holds the general solver's recall), one after another in
+//! the order of their steps, while the spectral solver takes the next steps on the run's
+//! thread. What the
 //! observer sees of a step, the turning points' checkpoints and the run's records wait
 //! ([`Held`]) until every check up to that step has agreed (each check sends its verdict as
-//! it ends). A check that contradicts takes
+//! it ends); beyond `OPEN_CHECKS` open checks (`history::run`) the spectral solver waits for
+//! the oldest. A check that contradicts takes
 //! the driver back to the state before its step (a copy kept when the step was committed)
 //! and the steps after it are dropped, as if they had never been tried: the records, the
 //! turning states and every call of the observer are those of the checks run in turn (test
@@ -73,29 +75,16 @@ impl Job {
     }
 }
 
-/// The end of the checks started so far: whether one contradicted (the later ones are then
-/// not run), and the recall.
-type ChainEnd<'r> = (bool, &'r mut Recall);
-
-/// The checks started: the end of the last one, or the thread that runs it (after the
-/// earlier ones).
-enum Chain<'scope, 'r> {
-    Ready(ChainEnd<'r>),
-    Running(ScopedJoinHandle<'scope, ChainEnd<'r>>),
-}
-
-impl<'r> Chain<'_, 'r> {
-    fn end(self) -> ChainEnd<'r> {
-        match self {
-            Self::Ready(end) => end,
-            Self::Running(thread) => thread.join().expect("a check does not panic"),
-        }
-    }
-}
-
 /// A check's verdict, as each check sends it when it is done: its step's index, and the
 /// handover if it contradicts.
 type Verdict = (usize, Option<Box<Handover>>);
+
+/// The thread that runs a stretch's checks in turn, with the run's recall: where the checks
+/// go, and the thread, which gives the recall back when the checks end.
+struct Worker<'scope, 'r> {
+    jobs: Sender<Job>,
+    thread: ScopedJoinHandle<'scope, &'r mut Recall>,
+}
 
 /// A check that contradicted its step at index `at` (the first in step order that did): the
 /// handover, and the driver before that step when the step was committed since (else the
@@ -107,16 +96,20 @@ pub(super) struct Contradiction {
 }
 
 /// The general solver's checks of a spectral stretch, in the order of their steps, on a
-/// thread of their own or in turn ([`Accelerations::concurrent_checks`]). Each sends its
-/// verdict when it is done, so that the steps before the next open check are verified as
-/// soon as the checks before them agree.
+/// thread of their own (one for the stretch) or in turn ([`Accelerations::concurrent_checks`]).
+/// Each sends its verdict when it is done, so that the steps before the next open check are
+/// verified as soon as the checks before them agree; after a contradiction the later checks
+/// are not run.
 ///
 /// [`Accelerations::concurrent_checks`]: crate::contact::tangential::Accelerations::concurrent_checks
 pub(super) struct Checks<'scope, 'env, 'r> {
     scope: &'scope Scope<'scope, 'env>,
     model: &'env ContactModel,
     options: RunOptions,
-    chain: Option<Chain<'scope, 'r>>,
+    /// The checks' thread, once a check has started (concurrent checks).
+    worker: Option<Worker<'scope, 'r>>,
+    /// The run's recall, unless the checks' thread holds it.
+    recall: Option<&'r mut Recall>,
     verdicts: (Sender<Verdict>, Receiver<Verdict>),
     /// The steps whose checks are not resolved, in order, each with the driver before it
     /// once the step is committed.
@@ -134,7 +127,8 @@ impl<'scope, 'env: 'scope, 'r: 'scope> Checks<'scope, 'env, 'r> {
             scope,
             model,
             options,
-            chain: Some(Chain::Ready((false, recall))),
+            worker: None,
+            recall: Some(recall),
             verdicts: std::sync::mpsc::channel(),
             open: VecDeque::new(),
         }
@@ -156,25 +150,43 @@ impl<'scope, 'env: 'scope, 'r: 'scope> Checks<'scope, 'env, 'r> {
             claim,
         };
         let (model, options) = (self.model, self.options);
-        let earlier = self.chain.take().expect("the chain is put back");
-        let verdicts = self.verdicts.0.clone();
-        let check = move || {
-            let (contradicted, recall) = earlier.end();
-            if contradicted {
-                return (true, recall);
-            }
-            let handover = job.run(model, options, recall).map(Box::new);
-            let found = handover.is_some();
-            // The receiver lives as long as the stretch, which joins every check.
-            let _ = verdicts.send((job.at, handover));
-            (found, recall)
-        };
-        self.chain = Some(if options.slip.accelerations.concurrent_checks {
-            Chain::Running(self.scope.spawn(check))
-        } else {
-            Chain::Ready(check())
-        });
         self.open.push_back((at, None));
+        if !options.slip.accelerations.concurrent_checks {
+            let recall = self
+                .recall
+                .as_deref_mut()
+                .expect("checks in turn keep the recall");
+            let handover = job.run(model, options, recall).map(Box::new);
+            let _ = self.verdicts.0.send((at, handover));
+            return;
+        }
+        if self.worker.is_none() {
+            let (jobs, inbox) = std::sync::mpsc::channel::<Job>();
+            let verdicts = self.verdicts.0.clone();
+            let recall = self.recall.take().expect("the recall is back");
+            let thread = self.scope.spawn(move || {
+                let mut contradicted = false;
+                for job in inbox {
+                    if contradicted {
+                        continue;
+                    }
+                    let handover = job.run(model, options, recall).map(Box::new);
+                    contradicted = handover.is_some();
+                    // The receiver lives as long as the stretch, which joins this thread.
+                    let _ = verdicts.send((job.at, handover));
+                }
+                // A thread per stretch: what its allocator kept would stay resident after it
+                // (a steady history begins a stretch at every take-back).
+                crate::shared::release_thread_memory();
+                recall
+            });
+            self.worker = Some(Worker { jobs, thread });
+        }
+        let worker = self.worker.as_ref().expect("started above");
+        worker
+            .jobs
+            .send(job)
+            .expect("the checks' thread runs until the stretch ends");
     }
 
     /// Before the step at index `at` is committed to `driver`: keep the driver's state for
@@ -190,12 +202,12 @@ impl<'scope, 'env: 'scope, 'r: 'scope> Checks<'scope, 'env, 'r> {
         self.open.front().map_or(usize::MAX, |&(k, _)| k)
     }
 
-    /// The verdicts of the checks done so far, in order (waiting for every open one when
-    /// `wait`): the checks that agreed are resolved, and the first contradiction is
-    /// returned (the checks after it are dropped).
-    pub(super) fn resolve(&mut self, wait: bool) -> Option<Contradiction> {
+    /// The verdicts of the checks done so far, in order, waiting for them while more than
+    /// `open` checks are open: the checks that agreed are resolved, and the first
+    /// contradiction is returned (the checks after it are dropped).
+    pub(super) fn resolve(&mut self, open: usize) -> Option<Contradiction> {
         while !self.open.is_empty() {
-            let verdict = if wait {
+            let verdict = if self.open.len() > open {
                 self.verdicts.1.recv().ok()
             } else {
                 self.verdicts.1.try_recv().ok()
@@ -203,8 +215,8 @@ impl<'scope, 'env: 'scope, 'r: 'scope> Checks<'scope, 'env, 'r> {
             let Some((at, handover)) = verdict else {
                 break;
             };
-            let (open, before) = self.open.pop_front().expect("an open check");
-            debug_assert_eq!(open, at, "verdicts come in the order of their steps");
+            let (step, before) = self.open.pop_front().expect("an open check");
+            debug_assert_eq!(step, at, "verdicts come in the order of their steps");
             if let Some(handover) = handover {
                 self.open.clear();
                 return Some(Contradiction {
@@ -217,14 +229,14 @@ impl<'scope, 'env: 'scope, 'r: 'scope> Checks<'scope, 'env, 'r> {
         None
     }
 
-    /// The general solver's recall, once every check has ended.
+    /// The general solver's recall, once every check has ended (the checks' thread is ended
+    /// and gives it back).
     pub(super) fn recall(&mut self) -> &mut Recall {
-        let end = self.chain.take().expect("the chain is put back").end();
-        self.chain = Some(Chain::Ready(end));
-        match self.chain.as_mut() {
-            Some(Chain::Ready((_, recall))) => recall,
-            _ => unreachable!("set above"),
+        if let Some(Worker { jobs, thread }) = self.worker.take() {
+            drop(jobs);
+            self.recall = Some(thread.join().expect("a check does not panic"));
         }
+        self.recall.as_deref_mut().expect("the recall is back")
     }
 }
 

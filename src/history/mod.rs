@@ -45,10 +45,11 @@
 //! own increments. Under [`SolverChoice::Auto`] the general solver also takes the first step
 //! of every phase, where thin end zones that slip the old way form in a coupled contact, and
 //! the spectral solver's step is handed over when the two disagree; it checks every turning
-//! point too. The checks run on a thread of their own while the spectral solver takes the
-//! steps after them, and what the observer sees of a step waits until the checks before it
-//! have agreed (`checks`): a contradicted step takes the run back to the state before it,
-//! and the run is the one of checks taken in turn, to the bit. The spectral solver tries
+//! point too. With `Accelerations::concurrent_checks` (off by default) the checks run on a
+//! thread of their own while the spectral solver takes the steps after them, and what the
+//! observer sees of a step waits until the checks before it have agreed (`checks`): a
+//! contradicted step takes the run back to the state before it, and the run is the one of
+//! checks taken in turn, to the bit. The spectral solver tries
 //! to take the state back after 2, 4, 8, … general steps of the phase and at its last step (a
 //! try gives up after 100 residual evaluations, a step under `auto` after
 //! `SlipOptions::step_evaluations`; a failed one costs several general steps). A take-back
