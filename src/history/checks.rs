@@ -111,6 +111,8 @@ pub(super) struct Checks<'scope, 'env, 'r> {
     /// The run's recall, unless the checks' thread holds it.
     recall: Option<&'r mut Recall>,
     verdicts: (Sender<Verdict>, Receiver<Verdict>),
+    /// Whether a check taken in turn contradicted its step (the later ones are then not run).
+    contradicted: bool,
     /// The steps whose checks are not resolved, in order, each with the driver before it
     /// once the step is committed.
     open: VecDeque<(usize, Option<Box<DriverState>>)>,
@@ -130,6 +132,7 @@ impl<'scope, 'env: 'scope, 'r: 'scope> Checks<'scope, 'env, 'r> {
             worker: None,
             recall: Some(recall),
             verdicts: std::sync::mpsc::channel(),
+            contradicted: false,
             open: VecDeque::new(),
         }
     }
@@ -152,12 +155,13 @@ impl<'scope, 'env: 'scope, 'r: 'scope> Checks<'scope, 'env, 'r> {
         let (model, options) = (self.model, self.options);
         self.open.push_back((at, None));
         if !options.slip.accelerations.concurrent_checks {
-            let recall = self
-                .recall
-                .as_deref_mut()
-                .expect("checks in turn keep the recall");
-            let handover = job.run(model, options, recall).map(Box::new);
-            let _ = self.verdicts.0.send((at, handover));
+            // As on the checks' thread: none after a contradiction.
+            if !self.contradicted {
+                let recall = (self.recall.as_deref_mut()).expect("checks in turn keep the recall");
+                let handover = job.run(model, options, recall).map(Box::new);
+                self.contradicted = handover.is_some();
+                let _ = self.verdicts.0.send((at, handover));
+            }
             return;
         }
         if self.worker.is_none() {
@@ -464,7 +468,7 @@ pub(super) fn contradicted(
     (point, options): (LoadPoint, RunOptions),
     spectral: &StepRecord,
     recall: &mut Recall,
-) -> Option<(StepFailure, (GeneralRun, StepRecord))> {
+) -> Option<Handover> {
     let mut run = GeneralRun::handover(model, before, options.general_element_size, recall);
     let general = run.step(model, point, recall).ok()?;
     let reason = disagreement(&run, &general, spectral)?;
@@ -503,7 +507,7 @@ pub(super) fn turning_checked(
     (point, options): (LoadPoint, RunOptions),
     spectral: &ContactState,
     recall: &mut Recall,
-) -> Option<(StepFailure, (GeneralRun, StepRecord))> {
+) -> Option<Handover> {
     let size = options.general_element_size;
     let mut run = GeneralRun::handover_onto(model, before, spectral, size, recall);
     // The check to a tolerance its bound allows; a step it contradicts, to the solver's own.
